@@ -1,0 +1,120 @@
+// Readers and writers (src/io/). Every format error throws g2s::Error(Exit::bad_input) with a
+// message naming the file, the place (line or byte offset) and what was expected; every write
+// failure throws g2s::Error(Exit::write_failed) and leaves no file at the target path.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "g2s/types.hpp"
+
+namespace g2s {
+
+// What a point reader saw, for the CLI summary and the tests.
+struct ReadReport {
+  std::string format;            // "ply-binary-le", "ply-binary-be", "ply-ascii", "xyz"
+  std::uint64_t declared = 0;    // points the header declares (0 for XYZ)
+  std::uint64_t points = 0;      // finite points returned
+  std::uint64_t non_finite = 0;  // points dropped for a NaN or Inf coordinate
+};
+
+// Reads the points of a cloud. PLY (ascii, binary little and big endian; the vertex element's
+// x, y, z as float or double at any position; other properties and elements skipped) or text
+// XYZ/PTS/TXT/CSV (space, tab or comma separated; extra columns ignored; '#' and '//' comment
+// lines; a PTS count line is skipped). The format is chosen by content (a "ply" magic line),
+// not by the file name; a non-PLY file holding binary bytes is an error. ASCII PLY rows are one
+// per line. Trailing bytes after a binary PLY's last element are ignored. NaN/Inf points are
+// dropped and counted. Duplicates are kept (the mesher merges them). Zero points is not an error
+// here (an empty cloud is returned; the caller decides). Throws Error(bad_input) for a missing,
+// unreadable or malformed file: "<file>: line N: ..." (text, PLY header) or "<file>: byte N: ..."
+// (binary body).
+PointCloud read_points(const std::filesystem::path& path, ReadReport* report = nullptr);
+
+// Reads a triangle mesh: binary STL (recognised by its size, 84 + 50 * count, not by a "solid"
+// header), ASCII STL, both welded by exact float coordinate equality (-0 == +0) with vertices
+// numbered in order of first use; or PLY with a vertex and a face element (a vertex_indices or
+// vertex_index list of any integer type; polygons are fanned from their first corner, faces with
+// fewer than 3 corners skipped). PLY vertices are kept as they are, non-finite ones included.
+// Triangle order is the file's. Throws Error(bad_input) like read_points.
+IndexedMesh read_mesh(const std::filesystem::path& path);
+
+enum class MeshFormat { stl_binary, stl_ascii, ply_binary };
+
+// The format for an output path: .ply -> ply_binary, otherwise STL (ascii when asked).
+MeshFormat mesh_format_for(const std::filesystem::path& path, bool ascii_stl);
+
+// A file that appears at its target path only when complete: writes go through a 1 MiB buffer
+// to a temporary ".NAME.tmp-<pid>-<n>" in the same folder; write_at patches bytes already
+// written (flushed or still buffered); commit() flushes, closes (checking the result; no fsync)
+// and renames over the target; destroying an uncommitted file removes the temporary. All OS
+// failures throw Error(write_failed, "<target>: <what>: <strerror>"), e.g. missing or read-only
+// folder, disk full (ENOSPC) or file size limit (EFBIG).
+class AtomicFile {
+ public:
+  explicit AtomicFile(const std::filesystem::path& target);
+  ~AtomicFile();
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+
+  void write(const void* data, std::size_t bytes);                           // buffered
+  void write_at(std::uint64_t offset, const void* data, std::size_t bytes);  // patch written bytes
+  std::uint64_t size() const;                                                // bytes written so far
+  void commit();
+  const std::filesystem::path& target() const { return target_; }
+  const std::filesystem::path& temporary() const { return temporary_; }
+
+ private:
+  void flush_buffer();
+  std::filesystem::path target_;
+  std::filesystem::path temporary_;
+  int fd_ = -1;
+  std::vector<char> buffer_;
+  std::uint64_t written_ = 0;  // bytes handed to the OS
+  bool committed_ = false;
+};
+
+// Streams triangles to STL (binary or ASCII) as they come: memory stays constant whatever the
+// count. Binary STL's triangle count is patched into the header by finish(). Facet normals are
+// the normalised cross product of the float corners (zero for a degenerate facet). ASCII STL
+// ("solid g2s" ... "endsolid g2s") prints the shortest text that reads back as the same float.
+// Destroyed without finish() (an exception went by), it leaves no file.
+class StlWriter {
+ public:
+  StlWriter(const std::filesystem::path& target, bool ascii);
+  void add(const double a[3], const double b[3], const double c[3]);
+  void finish();  // completes the file and renames it into place
+  std::uint64_t triangles() const { return count_; }
+
+ private:
+  AtomicFile file_;
+  bool ascii_;
+  std::uint64_t count_ = 0;
+};
+
+// Writes a mesh whose triangles index into xyz (3 doubles per point, point_count points) in the
+// given format. PLY output is indexed: only the points the triangles use are written, in order
+// of first use, as float (double when a coordinate does not round-trip through float), faces as
+// "list uchar uint vertex_indices". A triangle index past the points is Error(failure) (a bug),
+// thrown before anything is written.
+void write_mesh(const std::filesystem::path& target, std::span<const double> xyz,
+                std::span<const Triangle> triangles, MeshFormat format);
+
+// Writes points as binary little-endian PLY with float x, y, z, streamed: begin with the
+// count, add points, finish() checks the count and renames into place. A count mismatch throws
+// Error(failure) from finish() and leaves no file.
+class PlyPointWriter {
+ public:
+  PlyPointWriter(const std::filesystem::path& target, std::uint64_t count);
+  void add(float x, float y, float z);
+  void finish();
+
+ private:
+  AtomicFile file_;
+  std::uint64_t expected_;
+  std::uint64_t count_ = 0;
+};
+
+}  // namespace g2s

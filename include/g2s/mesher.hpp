@@ -1,0 +1,67 @@
+// The G2S mesher (src/grid, src/grow, src/cleanup): Gabriel 2-simplex mesh growing with the
+// discrete priority queue and non-manifold vertex removal of Di Angelo & Giaccari (2011).
+// It works on one tile: a span of points in a local frame, with their global ids, in;
+// triangles in global ids plus the still-open front edges out. docs/algorithm.md explains it.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <vector>
+
+#include "g2s/types.hpp"
+
+namespace g2s {
+
+struct MeshOptions {
+  // Search radius levels (ALGORITHM.md §5): the front search ball has radius
+  // step * max(|ab|, min_edge_fraction * spacing), tried in increasing order.
+  std::vector<double> radius_steps{1.0, 1.5, 2.0, 3.0};
+  // Flatness levels m: the fold angle beta in [0, max_fold_deg] quantised into m levels.
+  int flatness_levels = 4;
+  // A new triangle whose normal turns more than this from its front neighbour's is a fold.
+  double max_fold_deg = 135.0;
+  // No search ball is larger than this many spacings (the median nearest-neighbour distance):
+  // fronts do not bridge voids, and a query never scans a large part of the cloud.
+  double max_radius = 10.0;
+  // Seed search ball radius, in nearest-neighbour edge lengths (§3).
+  double seed_ball = 2.5;
+  // Orient each closed component outward (open ones away from the cloud centre).
+  bool orient = true;
+  // Called now and then while growing with (points used so far, points in total); may be empty.
+  std::function<void(std::uint64_t, std::uint64_t)> progress;
+};
+
+// Counts from one run, for the CLI summary, --json and the tests.
+struct MeshReport {
+  std::uint64_t points = 0;              // points given
+  std::uint64_t duplicates_merged = 0;   // exact duplicates left out of meshing
+  std::uint64_t seeds = 0;               // seed triangles (front components) grown
+  std::uint64_t triangles_grown = 0;     // before the non-manifold pass
+  std::uint64_t triangles_removed = 0;   // by the non-manifold pass
+  std::uint64_t non_manifold_vertices_fixed = 0;
+  std::uint64_t components_flipped = 0;  // components reoriented at the end
+  double spacing = 0.0;                  // estimated mean nearest-neighbour spacing
+  double seconds_grid = 0.0;
+  double seconds_grow = 0.0;
+  double seconds_cleanup = 0.0;
+};
+
+struct TileMesh {
+  std::vector<Triangle> triangles;              // in global ids
+  std::vector<std::array<Index, 2>> open_edges;  // boundary edges a->b as traversed by their triangle
+  MeshReport report;
+};
+
+// Meshes one tile. xyz: 3 floats per point in a local frame (subtract a tile origin computed in
+// double so floats keep their precision). ids: the global id of each point, or empty for
+// 0..n-1. Deterministic: the result depends only on the points, their ids and the options, not
+// on their order in the span.
+TileMesh mesh_tile(std::span<const float> xyz, std::span<const Index> ids,
+                   const MeshOptions& options);
+
+// Meshes a whole cloud in memory: shifts it to a local frame around its bounding-box centre and
+// calls mesh_tile. Triangles index into cloud.xyz.
+TileMesh mesh_cloud(const PointCloud& cloud, const MeshOptions& options);
+
+}  // namespace g2s

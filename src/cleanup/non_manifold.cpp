@@ -1,0 +1,116 @@
+// Non-manifold vertex removal, after Di Angelo & Giaccari (2011) §4.1 and ALGORITHM.md §6.
+// Instead of the paper's dynamic edge queue we walk each vertex's star directly: the star's
+// triangles are linked across the edges they share at the vertex, giving its fans; when there is
+// more than one, the closed fan (type I) or the largest (type II) is kept and the others are
+// deleted. Deleting can split a fan at the deleted triangles' other corners, so those go back on
+// a worklist. Each deletion is final, so the total work is linear in the mesh size.
+#include <algorithm>
+#include <numeric>
+
+#include "cleanup/cleanup.hpp"
+
+namespace g2s {
+namespace {
+
+std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t x) {
+  while (parent[x] != x) x = parent[x] = parent[parent[x]];
+  return x;
+}
+
+}  // namespace
+
+NonManifoldReport remove_non_manifold_vertices(std::vector<Triangle>& triangles,
+                                               std::size_t vertex_count) {
+  NonManifoldReport report;
+  const std::size_t nt = triangles.size();
+  // CSR: vertex -> incident triangles.
+  std::vector<std::uint32_t> start(vertex_count + 1, 0);
+  for (const Triangle& t : triangles) {
+    for (Index v : t) ++start[v + 1];
+  }
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<std::uint32_t> star(start.back());
+  {
+    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+    for (std::uint32_t t = 0; t < nt; ++t) {
+      for (Index v : triangles[t]) star[fill[v]++] = t;
+    }
+  }
+  std::vector<std::uint8_t> dead(nt, 0);
+  std::vector<std::uint8_t> queued(vertex_count, 1);
+  std::vector<Index> work(vertex_count);
+  std::iota(work.begin(), work.end(), Index{0});
+  std::reverse(work.begin(), work.end());  // pop from the back: vertex 0 first
+
+  // Scratch for one star.
+  std::vector<std::uint32_t> tris, parent, size;
+  std::vector<std::pair<Index, std::uint32_t>> spokes;  // (other corner, local triangle)
+  std::vector<std::uint8_t> open;
+
+  while (!work.empty()) {
+    const Index v = work.back();
+    work.pop_back();
+    queued[v] = 0;
+    tris.clear();
+    for (std::uint32_t k = start[v]; k < start[v + 1]; ++k) {
+      if (!dead[star[k]]) tris.push_back(star[k]);
+    }
+    if (tris.size() < 2) continue;
+    const auto m = static_cast<std::uint32_t>(tris.size());
+    parent.resize(m);
+    std::iota(parent.begin(), parent.end(), 0u);
+    spokes.clear();
+    for (std::uint32_t l = 0; l < m; ++l) {
+      for (Index w : triangles[tris[l]]) {
+        if (w != v) spokes.push_back({w, l});
+      }
+    }
+    std::sort(spokes.begin(), spokes.end());
+    for (std::size_t k = 0; k + 1 < spokes.size(); ++k) {
+      if (spokes[k].first == spokes[k + 1].first) {
+        parent[find_root(parent, spokes[k].second)] = find_root(parent, spokes[k + 1].second);
+      }
+    }
+    // Fans: size and closedness (closed when every spoke of the fan is shared by two triangles).
+    size.assign(m, 0);
+    open.assign(m, 0);
+    for (std::uint32_t l = 0; l < m; ++l) ++size[find_root(parent, l)];
+    for (std::size_t k = 0; k < spokes.size(); ++k) {
+      const bool shared = (k > 0 && spokes[k - 1].first == spokes[k].first) ||
+                          (k + 1 < spokes.size() && spokes[k + 1].first == spokes[k].first);
+      if (!shared) open[find_root(parent, spokes[k].second)] = 1;
+    }
+    std::uint32_t fans = 0, keep = kNoIndex;
+    for (std::uint32_t l = 0; l < m; ++l) {
+      if (find_root(parent, l) != l) continue;
+      ++fans;
+      // Prefer closed, then larger; ties keep the fan met first (lowest triangle index).
+      if (keep == kNoIndex || (open[keep] && !open[l]) ||
+          (open[keep] == open[l] && size[l] > size[keep])) {
+        keep = l;
+      }
+    }
+    if (fans < 2) continue;
+    ++report.vertices_fixed;
+    for (std::uint32_t l = 0; l < m; ++l) {
+      if (find_root(parent, l) == keep) continue;
+      dead[tris[l]] = 1;
+      ++report.triangles_removed;
+      for (Index w : triangles[tris[l]]) {
+        if (w != v && !queued[w]) {
+          queued[w] = 1;
+          work.push_back(w);
+        }
+      }
+    }
+  }
+
+  std::size_t out = 0;
+  for (std::size_t t = 0; t < nt; ++t) {
+    if (!dead[t]) triangles[out++] = triangles[t];
+  }
+  triangles.resize(out);
+  return report;
+}
+
+}  // namespace g2s

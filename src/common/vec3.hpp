@@ -1,0 +1,56 @@
+// Small 3-vectors for the geometry of the mesher: float for storage (points are many), double
+// for predicates (circumcentres of thin triangles need the precision).
+#pragma once
+
+#include <cmath>
+
+namespace g2s {
+
+struct Vec3f {
+  float x, y, z;
+};
+
+struct Vec3 {
+  double x, y, z;
+  Vec3() = default;
+  constexpr Vec3(double x_, double y_, double z_) : x(x_), y(y_), z(z_) {}
+  explicit Vec3(const Vec3f& v) : x(v.x), y(v.y), z(v.z) {}
+  Vec3 operator+(const Vec3& o) const { return {x + o.x, y + o.y, z + o.z}; }
+  Vec3 operator-(const Vec3& o) const { return {x - o.x, y - o.y, z - o.z}; }
+  Vec3 operator*(double s) const { return {x * s, y * s, z * s}; }
+};
+
+inline double dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline Vec3 cross(const Vec3& a, const Vec3& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline double norm2(const Vec3& a) { return dot(a, a); }
+inline double norm(const Vec3& a) { return std::sqrt(dot(a, a)); }
+inline Vec3 normalized(const Vec3& a) {
+  const double n = norm(a);
+  return n > 0 ? a * (1.0 / n) : Vec3{0, 0, 0};
+}
+
+// The smallest ball through a, b, c: centre at the circumcentre (in the triangle's plane),
+// radius^2 = the squared circumradius. False when the triangle is (nearly) degenerate.
+struct Ball {
+  Vec3 centre;
+  double radius2;
+};
+
+inline bool circumball(const Vec3& a, const Vec3& b, const Vec3& c, Ball& out) {
+  const Vec3 u = b - a;
+  const Vec3 v = c - a;
+  const Vec3 w = cross(u, v);
+  const double w2 = norm2(w);
+  const double uu = norm2(u);
+  const double vv = norm2(v);
+  // Reject slivers whose circumcentre is numerically meaningless.
+  if (!(w2 > 1e-12 * uu * vv)) return false;
+  const Vec3 offset = (cross(w, u) * vv + cross(v, w) * uu) * (0.5 / w2);
+  out.centre = a + offset;
+  out.radius2 = norm2(offset);
+  return true;
+}
+
+}  // namespace g2s

@@ -1,0 +1,180 @@
+// Builds the hash grid: cell size from the sampling spacing, points radix-sorted into Morton
+// order of their cells, duplicates merged, and the cell hash filled. See hash_grid.hpp.
+#include "grid/hash_grid.hpp"
+
+#include <numeric>
+
+namespace g2s {
+namespace {
+
+constexpr std::uint64_t kEmpty = ~0ull;
+constexpr std::int64_t kMaxDim = (1 << 21) - 2;
+
+// Sorts (key, value) pairs by key with an LSD radix sort over the low key_bits bits. Stable, so
+// equal keys keep the order they came in.
+void radix_sort(std::vector<std::uint64_t>& keys, std::vector<std::uint32_t>& values,
+                int key_bits) {
+  constexpr int kDigit = 11;
+  const std::size_t n = keys.size();
+  std::vector<std::uint64_t> keys_tmp(n);
+  std::vector<std::uint32_t> values_tmp(n);
+  std::vector<std::uint32_t> count(1u << kDigit);
+  for (int shift = 0; shift < key_bits; shift += kDigit) {
+    std::fill(count.begin(), count.end(), 0);
+    for (std::size_t i = 0; i < n; ++i) ++count[keys[i] >> shift & ((1u << kDigit) - 1)];
+    std::uint32_t sum = 0;
+    for (auto& c : count) {
+      const std::uint32_t k = c;
+      c = sum;
+      sum += k;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::uint32_t d = keys[i] >> shift & ((1u << kDigit) - 1);
+      const std::uint32_t to = count[d]++;
+      keys_tmp[to] = keys[i];
+      values_tmp[to] = values[i];
+    }
+    keys.swap(keys_tmp);
+    values.swap(values_tmp);
+  }
+}
+
+int bits_for(std::int64_t v) {
+  int b = 1;
+  while ((std::int64_t{1} << b) <= v) ++b;
+  return b;
+}
+
+}  // namespace
+
+HashGrid::HashGrid(std::span<const float> xyz, std::span<const Index> ids) {
+  const std::size_t n = xyz.size() / 3;
+  double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = n ? xyz[a] : 0.0;
+    hi[a] = lo[a];
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min<double>(lo[a], xyz[3 * i + a]);
+      hi[a] = std::max<double>(hi[a], xyz[3 * i + a]);
+    }
+  }
+  for (int a = 0; a < 3; ++a) origin_[a] = lo[a];
+  const double dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
+  const double extent = std::max({dx, dy, dz});
+  // A surface spanning the box has an area of the order of its largest faces.
+  double area = dx * dy + dy * dz + dz * dx;
+  if (!(area > 0)) area = extent * extent;
+  double cell = n > 1 && area > 0 ? 2.0 * std::sqrt(area / static_cast<double>(n)) : 1.0;
+  const double min_cell = extent > 0 ? extent / static_cast<double>(kMaxDim) : 1.0;
+
+  build(xyz, ids, std::max(cell, min_cell));
+  spacing_ = estimate_spacing();
+  // Aim for a cell edge of about two spacings: a front search ball then spans about two cells
+  // per axis and a cell holds a handful of surface points.
+  if (spacing_ > 0) {
+    const double wanted = std::max(2.0 * spacing_, min_cell);
+    if (wanted < 0.7 * cell_ || wanted > 1.4 * cell_) {
+      build(xyz, ids, wanted);
+      spacing_ = estimate_spacing();
+    }
+  }
+}
+
+void HashGrid::build(std::span<const float> xyz, std::span<const Index> ids, double cell) {
+  const std::size_t n = xyz.size() / 3;
+  cell_ = cell;
+  inv_cell_ = 1.0 / cell;
+  std::int64_t max_dim = 1;
+  for (int a = 0; a < 3; ++a) {
+    double hi = origin_[a];
+    for (std::size_t i = 0; i < n; ++i) hi = std::max<double>(hi, xyz[3 * i + a]);
+    dims_[a] = std::min(cell_coord(hi, a) + 1, kMaxDim + 1);
+    max_dim = std::max(max_dim, dims_[a]);
+  }
+
+  std::vector<std::uint64_t> codes(n);
+  std::vector<std::uint32_t> order(n);
+  std::iota(order.begin(), order.end(), 0u);
+  auto coord = [&](std::size_t i, int a) {
+    return static_cast<std::uint64_t>(
+        std::clamp<std::int64_t>(cell_coord(xyz[3 * i + a], a), 0, dims_[a] - 1));
+  };
+  for (std::size_t i = 0; i < n; ++i) codes[i] = morton3(coord(i, 0), coord(i, 1), coord(i, 2));
+  radix_sort(codes, order, 3 * bits_for(max_dim));
+
+  auto id_of = [&](std::uint32_t i) { return ids.empty() ? i : ids[i]; };
+  auto less = [&](std::uint32_t i, std::uint32_t j) {
+    for (int a = 0; a < 3; ++a) {
+      if (xyz[3 * i + a] != xyz[3 * j + a]) return xyz[3 * i + a] < xyz[3 * j + a];
+    }
+    return id_of(i) < id_of(j);
+  };
+  auto same = [&](std::uint32_t i, std::uint32_t j) {
+    return xyz[3 * i] == xyz[3 * j] && xyz[3 * i + 1] == xyz[3 * j + 1] &&
+           xyz[3 * i + 2] == xyz[3 * j + 2];
+  };
+
+  points_.clear();
+  ids_.clear();
+  cell_start_.clear();
+  points_.reserve(n);
+  ids_.reserve(n);
+  std::vector<std::uint64_t> cell_codes;
+  duplicates_ = 0;
+  // Within a cell: order by coordinates, then id, so the result does not depend on input order
+  // and exact duplicates are adjacent.
+  for (std::size_t begin = 0; begin < n;) {
+    std::size_t end = begin + 1;
+    while (end < n && codes[end] == codes[begin]) ++end;
+    std::sort(order.begin() + begin, order.begin() + end, less);
+    cell_codes.push_back(codes[begin]);
+    cell_start_.push_back(static_cast<std::uint32_t>(points_.size()));
+    for (std::size_t k = begin; k < end; ++k) {
+      const std::uint32_t i = order[k];
+      if (k > begin && same(i, order[k - 1])) {
+        ++duplicates_;
+        continue;
+      }
+      points_.push_back({xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]});
+      ids_.push_back(id_of(i));
+    }
+    begin = end;
+  }
+  cell_start_.push_back(static_cast<std::uint32_t>(points_.size()));
+
+  std::size_t slots = 16;
+  while (slots < 2 * cell_codes.size()) slots *= 2;
+  slot_mask_ = slots - 1;
+  slot_code_.assign(slots, kEmpty);
+  slot_cell_.assign(slots, kNoIndex);
+  for (std::uint32_t c = 0; c < cell_codes.size(); ++c) {
+    std::uint64_t slot = (cell_codes[c] * 0x9E3779B97F4A7C15ull) >> 20 & slot_mask_;
+    while (slot_code_[slot] != kEmpty) slot = (slot + 1) & slot_mask_;
+    slot_code_[slot] = cell_codes[c];
+    slot_cell_[slot] = c;
+  }
+}
+
+double HashGrid::estimate_spacing() const {
+  const std::uint32_t n = size();
+  if (n < 2) return 0.0;
+  const std::uint32_t samples = std::min<std::uint32_t>(n, 4096);
+  const double max_radius =
+      cell_ * static_cast<double>(std::max({dims_[0], dims_[1], dims_[2]})) * 2.0;
+  std::vector<double> d;
+  d.reserve(samples);
+  for (std::uint32_t s = 0; s < samples; ++s) {
+    const std::uint32_t i =
+        static_cast<std::uint32_t>(static_cast<std::uint64_t>(s) * n / samples);
+    const std::uint32_t j = nearest(i, max_radius, [](std::uint32_t) { return true; });
+    if (j != kNoIndex) d.push_back(std::sqrt(norm2(position(i) - position(j))));
+  }
+  if (d.empty()) return 0.0;
+  // The median: robust to outliers and to the few isolated points every scan has.
+  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
+  return d[d.size() / 2];
+}
+
+}  // namespace g2s

@@ -1,0 +1,129 @@
+// Flat hash grid for fixed-radius neighbour search (ALGORITHM.md §2). Points are sorted once
+// into Morton order of their cells (a radix sort), so a cell's points are contiguous and
+// neighbouring cells lie close in memory; non-empty cells are found through an open-addressing
+// hash of their Morton code, so empty space costs nothing. Exact duplicate points are merged
+// while sorting (the one with the smallest id is kept).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "common/vec3.hpp"
+#include "g2s/types.hpp"
+
+namespace g2s {
+
+class HashGrid {
+ public:
+  // Builds the grid over xyz (3 floats per point) with global ids (empty: 0..n-1). The cell
+  // edge is chosen from the estimated sampling spacing.
+  HashGrid(std::span<const float> xyz, std::span<const Index> ids);
+
+  std::uint32_t size() const { return static_cast<std::uint32_t>(points_.size()); }
+  const Vec3f& point(std::uint32_t i) const { return points_[i]; }
+  Vec3 position(std::uint32_t i) const { return Vec3(points_[i]); }
+  Index id(std::uint32_t i) const { return ids_[i]; }
+  std::span<const Vec3f> points() const { return points_; }
+  std::uint64_t duplicates_merged() const { return duplicates_; }
+  double spacing() const { return spacing_; }  // mean nearest-neighbour distance (sampled)
+  double cell_size() const { return cell_; }
+
+  // Calls visit(i, squared distance) for every point within radius of centre.
+  template <class Visit>
+  void for_each_in_ball(const Vec3& centre, double radius, Visit&& visit) const;
+
+  // Nearest point to point i among those accepted by keep(j), within max_radius; kNoIndex if
+  // none.
+  template <class Keep>
+  std::uint32_t nearest(std::uint32_t i, double max_radius, Keep&& keep) const;
+
+ private:
+  void build(std::span<const float> xyz, std::span<const Index> ids, double cell);
+  double estimate_spacing() const;
+  std::int64_t cell_coord(double v, int axis) const {
+    return static_cast<std::int64_t>(std::floor((v - origin_[axis]) * inv_cell_));
+  }
+  std::uint32_t find_cell(std::uint64_t code) const;
+
+  std::vector<Vec3f> points_;
+  std::vector<Index> ids_;
+  std::vector<std::uint32_t> cell_start_;  // cells + 1 offsets into points_
+  std::vector<std::uint64_t> slot_code_;   // hash slots: Morton code of the cell, or kEmpty
+  std::vector<std::uint32_t> slot_cell_;   // hash slots: cell index
+  std::uint64_t slot_mask_ = 0;
+  double origin_[3] = {0, 0, 0};
+  double cell_ = 1.0;
+  double inv_cell_ = 1.0;
+  std::int64_t dims_[3] = {1, 1, 1};
+  double spacing_ = 0.0;
+  std::uint64_t duplicates_ = 0;
+};
+
+// Interleaves the low 21 bits of x, y, z.
+inline std::uint64_t morton3(std::uint64_t x, std::uint64_t y, std::uint64_t z) {
+  auto spread = [](std::uint64_t v) {
+    v &= 0x1fffff;
+    v = (v | v << 32) & 0x1f00000000ffffull;
+    v = (v | v << 16) & 0x1f0000ff0000ffull;
+    v = (v | v << 8) & 0x100f00f00f00f00full;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ull;
+    v = (v | v << 2) & 0x1249249249249249ull;
+    return v;
+  };
+  return spread(x) | spread(y) << 1 | spread(z) << 2;
+}
+
+inline std::uint32_t HashGrid::find_cell(std::uint64_t code) const {
+  std::uint64_t slot = (code * 0x9E3779B97F4A7C15ull) >> 20 & slot_mask_;
+  for (;;) {
+    const std::uint64_t c = slot_code_[slot];
+    if (c == code) return slot_cell_[slot];
+    if (c == ~0ull) return kNoIndex;
+    slot = (slot + 1) & slot_mask_;
+  }
+}
+
+template <class Visit>
+void HashGrid::for_each_in_ball(const Vec3& centre, double radius, Visit&& visit) const {
+  const double r2 = radius * radius;
+  std::int64_t lo[3], hi[3];
+  const double c[3] = {centre.x, centre.y, centre.z};
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = std::max<std::int64_t>(cell_coord(c[a] - radius, a), 0);
+    hi[a] = std::min<std::int64_t>(cell_coord(c[a] + radius, a), dims_[a] - 1);
+    if (lo[a] > hi[a]) return;
+  }
+  for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
+    for (std::int64_t y = lo[1]; y <= hi[1]; ++y) {
+      for (std::int64_t x = lo[0]; x <= hi[0]; ++x) {
+        const std::uint32_t cell = find_cell(morton3(x, y, z));
+        if (cell == kNoIndex) continue;
+        for (std::uint32_t i = cell_start_[cell], end = cell_start_[cell + 1]; i < end; ++i) {
+          const Vec3f& p = points_[i];
+          const double dx = p.x - centre.x, dy = p.y - centre.y, dz = p.z - centre.z;
+          const double d2 = dx * dx + dy * dy + dz * dz;
+          if (d2 <= r2) visit(i, d2);
+        }
+      }
+    }
+  }
+}
+
+template <class Keep>
+std::uint32_t HashGrid::nearest(std::uint32_t i, double max_radius, Keep&& keep) const {
+  const Vec3 c = position(i);
+  for (double r = std::min(cell_, max_radius);; r = std::min(r * 2, max_radius)) {
+    std::uint32_t best = kNoIndex;
+    double best_d2 = 0;
+    for_each_in_ball(c, r, [&](std::uint32_t j, double d2) {
+      if (j == i || !keep(j)) return;
+      if (best == kNoIndex || d2 < best_d2 || (d2 == best_d2 && j < best)) best = j, best_d2 = d2;
+    });
+    if (best != kNoIndex || r >= max_radius) return best;
+  }
+}
+
+}  // namespace g2s

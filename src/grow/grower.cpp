@@ -1,0 +1,306 @@
+// G2S mesh growing, after Di Angelo & Giaccari (2011), "A fast algorithm for manifold
+// reconstruction of surfaces" §3-4, and ALGORITHM.md §3-5. For each free front edge, the
+// Gabriel walk picks the point whose smallest circumscribing ball with the edge holds no other
+// candidate; the discrete priority queue (radius level, then flatness level) meshes the flattest,
+// best-sampled regions first; the Point-Edge Map keeps every edge manifold and every pair of
+// neighbouring triangles consistently oriented.
+#include "grow/grower.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "grow/bucket_queue.hpp"
+#include "common/edge_map.hpp"
+
+namespace g2s {
+namespace {
+
+// A free edge a->b, as traversed by its only triangle; cand caches the point chosen for it when
+// it was re-queued at a worse priority (re-validated when popped).
+struct FrontEdge {
+  Index a, b;
+  std::uint32_t triangle;
+  Index cand;
+};
+
+struct Candidate {
+  Index point = kNoIndex;
+  int priority = 0;
+};
+
+bool traverses(const Triangle& t, Index u, Index v) {
+  return (t[0] == u && t[1] == v) || (t[1] == u && t[2] == v) || (t[2] == u && t[0] == v);
+}
+
+Index apex(const Triangle& t, Index u, Index v) {
+  for (Index w : t) {
+    if (w != u && w != v) return w;
+  }
+  return kNoIndex;
+}
+
+class Grower {
+ public:
+  Grower(const HashGrid& grid, const MeshOptions& options)
+      : grid_(grid),
+        options_(options),
+        levels_(static_cast<int>(options.radius_steps.size())),
+        flat_levels_(std::max(1, options.flatness_levels)),
+        edges_(std::size_t{3} * grid.size()),
+        used_(grid.size(), 0),
+        seed_tried_(grid.size(), 0),
+        open_count_(grid.size(), 0),
+        queue_(std::max(1, levels_ * flat_levels_)),
+        max_fold_(options.max_fold_deg * std::numbers::pi / 180.0),
+        cos_max_fold_(std::cos(max_fold_)),
+        radius_floor_(0.5 * grid.spacing()),
+        radius_cap_(options.max_radius * grid.spacing()) {
+    triangles_.reserve(std::size_t{2} * grid.size());
+  }
+
+  GrowResult run() {
+    GrowResult result;
+    for (std::uint32_t i = 0; i < grid_.size(); ++i) {
+      if (used_[i] || seed_tried_[i]) continue;
+      seed_tried_[i] = 1;
+      if (!try_seed(i)) continue;
+      ++result.seeds;
+      drain();
+    }
+    result.triangles = std::move(triangles_);
+    return result;
+  }
+
+ private:
+  bool interior(Index i) const { return used_[i] && open_count_[i] == 0; }
+
+  Vec3 normal_of(std::uint32_t t) const {
+    const Triangle& tri = triangles_[t];
+    const Vec3 a = grid_.position(tri[0]);
+    return normalized(cross(grid_.position(tri[1]) - a, grid_.position(tri[2]) - a));
+  }
+
+  // Appends triangle (a, b, c) and updates the Point-Edge Map, the open-edge counts and the front.
+  void add_triangle(Index a, Index b, Index c) {
+    const auto t = static_cast<std::uint32_t>(triangles_.size());
+    triangles_.push_back({a, b, c});
+    const Index corners[3] = {a, b, c};
+    for (int k = 0; k < 3; ++k) {
+      const Index u = corners[k], v = corners[(k + 1) % 3];
+      const bool existed = edges_.find(u, v) != EdgeMap::kMissing;
+      edges_.add(u, v, t);
+      if (existed) {
+        --open_count_[u];
+        --open_count_[v];
+      } else {
+        ++open_count_[u];
+        ++open_count_[v];
+        queue_.push(0, {u, v, t, kNoIndex});
+      }
+    }
+    for (Index v : corners) {
+      used_count_ += !used_[v];
+      used_[v] = 1;
+    }
+    if (options_.progress && (t & 0xFFFF) == 0) options_.progress(used_count_, grid_.size());
+  }
+
+  // Processes front edges until the front is empty (ALGORITHM.md §5).
+  void drain() {
+    FrontEdge e;
+    while (!queue_.empty()) {
+      const int level = queue_.pop(e);
+      if (edges_.find(e.a, e.b) != e.triangle) continue;  // closed meanwhile
+      excluded_.clear();
+      if (e.cand != kNoIndex) {
+        if (!interior(e.cand) && try_add(e, e.cand)) continue;
+        excluded_.push_back(e.cand);
+      }
+      for (int attempt = 0; attempt < 3; ++attempt) {
+        const Candidate c = find_candidate(e);
+        if (c.point == kNoIndex) break;  // a boundary edge, unless a neighbour closes it
+        if (c.priority > level) {
+          queue_.push(c.priority, {e.a, e.b, e.triangle, c.point});
+          break;
+        }
+        if (try_add(e, c.point)) break;
+        excluded_.push_back(c.point);
+      }
+    }
+  }
+
+  // The Gabriel walk over cand_: start at the candidate nearest the edge midpoint, move to the
+  // candidate deepest inside the current smallest ball through a, b and the chosen point, stop
+  // when no candidate is inside. Co-circular ties go to the smaller index (ALGORITHM.md §1).
+  Index gabriel_walk(const Vec3& a, const Vec3& b, const Vec3& mid) {
+    std::size_t start = 0;
+    double best = 0;
+    for (std::size_t k = 0; k < cand_.size(); ++k) {
+      const double d2 = norm2(grid_.position(cand_[k]) - mid);
+      if (k == 0 || d2 < best || (d2 == best && cand_[k] < cand_[start])) start = k, best = d2;
+    }
+    Index p = cand_[start];
+    for (std::size_t step = 0; step <= cand_.size(); ++step) {
+      Ball ball;
+      if (!circumball(a, b, grid_.position(p), ball)) return kNoIndex;
+      const double tol = 1e-6 * ball.radius2;
+      Index next = kNoIndex;
+      double deepest = 0;
+      for (Index q : cand_) {
+        if (q == p) continue;
+        const double depth = norm2(grid_.position(q) - ball.centre) - ball.radius2;
+        const bool inside = depth < -tol || (depth <= tol && q < p);
+        if (inside && (next == kNoIndex || depth < deepest)) next = q, deepest = depth;
+      }
+      if (next == kNoIndex) return p;
+      p = next;
+    }
+    return p;
+  }
+
+  // The point to grow edge e onto, and its priority value m*(radius level) + flatness level.
+  Candidate find_candidate(const FrontEdge& e) {
+    const Index c = apex(triangles_[e.triangle], e.a, e.b);
+    const Vec3 a = grid_.position(e.a), b = grid_.position(e.b), pc = grid_.position(c);
+    const Vec3 n = normalized(cross(b - a, pc - a));
+    const Vec3 ab = b - a;
+    const double len = norm(ab);
+    const Vec3 mid = (a + b) * 0.5;
+    const Vec3 out = normalized(cross(ab, n));
+    const double base = std::max(len, radius_floor_);
+    if (len >= radius_cap_) return {};
+    for (int level = 0; level < levels_; ++level) {
+      const double radius =
+          std::min(options_.radius_steps[static_cast<std::size_t>(level)] * base, radius_cap_);
+      const double along = std::sqrt(std::max(radius * radius - 0.25 * len * len, 0.0));
+      cand_.clear();
+      grid_.for_each_in_ball(mid + out * along, radius, [&](std::uint32_t j, double) {
+        if (j == e.a || j == e.b || j == c || interior(j)) return;
+        if (dot(grid_.position(j) - mid, out) <= 0) return;
+        if (std::find(excluded_.begin(), excluded_.end(), j) != excluded_.end()) return;
+        cand_.push_back(j);
+      });
+      while (!cand_.empty()) {
+        const Index p = gabriel_walk(a, b, mid);
+        if (p == kNoIndex) break;
+        const Vec3 n_new = normalized(cross(a - b, grid_.position(p) - b));
+        const double beta = std::acos(std::clamp(dot(n, n_new), -1.0, 1.0));
+        if (beta <= max_fold_) {
+          const int flat = std::min(flat_levels_ - 1, static_cast<int>(beta / max_fold_ *
+                                                                        flat_levels_));
+          return {p, level * flat_levels_ + flat};
+        }
+        cand_.erase(std::find(cand_.begin(), cand_.end(), p));  // a fold: walk the rest
+      }
+    }
+    return {};
+  }
+
+  // Adds triangle (b, a, p) across front edge a->b if the Point-Edge Map allows it: no edge gets
+  // a third triangle, shared edges are traversed in opposite directions, no duplicate, no fold.
+  bool try_add(const FrontEdge& e, Index p) {
+    if (interior(p) || p == e.a || p == e.b) return false;
+    const std::uint32_t on_ap = edges_.find(e.a, p);
+    const std::uint32_t on_pb = edges_.find(p, e.b);
+    if (on_ap != EdgeMap::kMissing) {
+      if ((on_ap & EdgeMap::kClosed) || on_ap == e.triangle) return false;
+      if (!traverses(triangles_[on_ap], p, e.a)) return false;
+    }
+    if (on_pb != EdgeMap::kMissing) {
+      if ((on_pb & EdgeMap::kClosed) || on_pb == e.triangle) return false;
+      if (!traverses(triangles_[on_pb], e.b, p)) return false;
+      if (on_pb == on_ap) return false;
+    }
+    const Vec3 a = grid_.position(e.a), b = grid_.position(e.b);
+    const Vec3 n_new = normalized(cross(a - b, grid_.position(p) - b));
+    if (norm2(n_new) == 0) return false;
+    for (std::uint32_t t : {on_ap, on_pb}) {
+      if (t != EdgeMap::kMissing && dot(n_new, normal_of(t)) < cos_max_fold_) return false;
+    }
+    add_triangle(e.b, e.a, p);
+    return true;
+  }
+
+  // A seed triangle (ALGORITHM.md §3): point i, its nearest unused neighbour, and the nearest
+  // third point that makes a Gabriel triangle whose circumcircle's cylinder is not cut by points
+  // on both sides (it does not bridge a thin part).
+  bool try_seed(Index i) {
+    const double spacing = std::max(grid_.spacing(), 1e-30);
+    const auto unused = [&](std::uint32_t j) { return !used_[j]; };
+    const Index q = grid_.nearest(i, 4.0 * spacing, unused);
+    if (q == kNoIndex) return false;
+    const Vec3 p0 = grid_.position(i), p1 = grid_.position(q);
+    const Vec3 mid = (p0 + p1) * 0.5;
+    const double radius = options_.seed_ball * norm(p1 - p0);
+    near_.clear();
+    grid_.for_each_in_ball(mid, radius, [&](std::uint32_t j, double d2) {
+      near_.push_back({d2, j});
+    });
+    std::sort(near_.begin(), near_.end());
+    for (const auto& [d2, r] : near_) {
+      if (r == i || r == q || used_[r]) continue;
+      const Vec3 p2 = grid_.position(r);
+      Ball ball;
+      if (!circumball(p0, p1, p2, ball)) continue;
+      const double tol = 1e-6 * ball.radius2;
+      const double reach = std::sqrt(ball.radius2) + norm(ball.centre - mid);
+      bool gabriel = true;
+      const auto check = [&](std::uint32_t j) {
+        if (j == i || j == q || j == r) return;
+        if (norm2(grid_.position(j) - ball.centre) < ball.radius2 - tol) gabriel = false;
+      };
+      if (reach <= radius) {
+        for (const auto& nj : near_) check(nj.second);
+      } else {
+        grid_.for_each_in_ball(ball.centre, std::sqrt(ball.radius2),
+                               [&](std::uint32_t j, double) { check(j); });
+      }
+      if (!gabriel) continue;
+      const Vec3 n = normalized(cross(p1 - p0, p2 - p0));
+      const double slack = 0.2 * std::sqrt(ball.radius2);
+      bool above = false, below = false;
+      for (const auto& nj : near_) {
+        const std::uint32_t j = nj.second;
+        if (j == i || j == q || j == r) continue;
+        const Vec3 d = grid_.position(j) - ball.centre;
+        const double h = dot(d, n);
+        if (norm2(d) - h * h >= ball.radius2) continue;  // outside the cylinder
+        above |= h > slack;
+        below |= h < -slack;
+      }
+      if (above && below) continue;
+      add_triangle(i, q, r);
+      return true;
+    }
+    return false;
+  }
+
+  const HashGrid& grid_;
+  const MeshOptions& options_;
+  const int levels_;
+  const int flat_levels_;
+  std::vector<Triangle> triangles_;
+  EdgeMap edges_;
+  std::vector<std::uint8_t> used_;
+  std::vector<std::uint8_t> seed_tried_;
+  std::vector<std::uint32_t> open_count_;
+  std::uint64_t used_count_ = 0;
+  BucketQueue<FrontEdge> queue_;
+  const double max_fold_;
+  const double cos_max_fold_;
+  const double radius_floor_;
+  const double radius_cap_;
+  // Scratch, reused across edges so the inner loop does not allocate.
+  std::vector<Index> cand_;
+  std::vector<Index> excluded_;
+  std::vector<std::pair<double, std::uint32_t>> near_;
+};
+
+}  // namespace
+
+GrowResult grow_mesh(const HashGrid& grid, const MeshOptions& options) {
+  return Grower(grid, options).run();
+}
+
+}  // namespace g2s

@@ -1,0 +1,129 @@
+// AtomicFile: output appears at its target only when complete. Writes go through a 1 MiB buffer
+// to ".NAME.tmp-<pid>-<n>" beside the target; commit() flushes, closes (checking the result, so
+// delayed write errors surface) and renames. No fsync: speed over surviving a power cut.
+#include <fcntl.h>
+#include <fmt/core.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+
+#include "g2s/error.hpp"
+#include "g2s/io.hpp"
+
+namespace g2s {
+namespace {
+
+constexpr std::size_t kBufferSize = 1u << 20;
+std::atomic<std::uint64_t> g_counter{0};
+
+[[noreturn]] void fail_write(const std::filesystem::path& target, const char* what, int err) {
+  throw Error(Exit::write_failed,
+              fmt::format("{}: {}: {}", target.string(), what, std::strerror(err)));
+}
+
+}  // namespace
+
+AtomicFile::AtomicFile(const std::filesystem::path& target) : target_(target) {
+  const std::string name = target_.filename().string();
+  if (name.empty() || name == "." || name == "..") {
+    throw Error(Exit::write_failed,
+                fmt::format("{}: not a file name (the path names a folder)", target_.string()));
+  }
+  struct stat st {};
+  if (::stat(target_.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
+    fail_write(target_, "cannot write", EISDIR);
+  temporary_ = target_.parent_path() /
+               fmt::format(".{}.tmp-{}-{}", name, static_cast<long>(::getpid()), g_counter++);
+  fd_ = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd_ < 0) fail_write(target_, "cannot create", errno);
+  buffer_.reserve(kBufferSize);
+}
+
+AtomicFile::~AtomicFile() {
+  if (fd_ >= 0) ::close(fd_);
+  if (!committed_ && !temporary_.empty()) ::unlink(temporary_.c_str());
+}
+
+void AtomicFile::flush_buffer() {
+  const char* p = buffer_.data();
+  std::size_t left = buffer_.size();
+  while (left > 0) {
+    const ssize_t n = ::write(fd_, p, left);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      fail_write(target_, "write failed", errno);
+    }
+    if (n == 0) fail_write(target_, "write failed", EIO);
+    p += n;
+    left -= static_cast<std::size_t>(n);
+    written_ += static_cast<std::uint64_t>(n);
+  }
+  buffer_.clear();
+}
+
+void AtomicFile::write(const void* data, std::size_t bytes) {
+  if (fd_ < 0) fail_write(target_, "write after commit", EBADF);
+  const char* p = static_cast<const char*>(data);
+  if (buffer_.size() + bytes > kBufferSize) {
+    flush_buffer();
+    // A block as large as the buffer goes straight to the OS.
+    while (bytes >= kBufferSize) {
+      const ssize_t n = ::write(fd_, p, bytes);
+      if (n < 0) {
+        if (errno == EINTR) continue;
+        fail_write(target_, "write failed", errno);
+      }
+      if (n == 0) fail_write(target_, "write failed", EIO);
+      p += n;
+      bytes -= static_cast<std::size_t>(n);
+      written_ += static_cast<std::uint64_t>(n);
+    }
+  }
+  buffer_.insert(buffer_.end(), p, p + bytes);
+}
+
+void AtomicFile::write_at(std::uint64_t offset, const void* data, std::size_t bytes) {
+  if (fd_ < 0) fail_write(target_, "write after commit", EBADF);
+  if (offset > size() || bytes > size() - offset) {
+    throw Error(Exit::failure, fmt::format("{}: write_at({}, {} bytes) beyond the {} bytes written",
+                                           target_.string(), offset, bytes, size()));
+  }
+  const char* p = static_cast<const char*>(data);
+  // The part already handed to the OS.
+  while (bytes > 0 && offset < written_) {
+    const std::size_t part =
+        static_cast<std::size_t>(std::min<std::uint64_t>(bytes, written_ - offset));
+    const ssize_t n = ::pwrite(fd_, p, part, static_cast<off_t>(offset));
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      fail_write(target_, "write failed", errno);
+    }
+    if (n == 0) fail_write(target_, "write failed", EIO);
+    p += n;
+    bytes -= static_cast<std::size_t>(n);
+    offset += static_cast<std::uint64_t>(n);
+  }
+  // The part still in the buffer.
+  if (bytes > 0) std::memcpy(buffer_.data() + (offset - written_), p, bytes);
+}
+
+std::uint64_t AtomicFile::size() const {
+  return written_ + buffer_.size();
+}
+
+void AtomicFile::commit() {
+  if (fd_ < 0) fail_write(target_, "commit after commit", EBADF);
+  flush_buffer();
+  const int fd = fd_;
+  fd_ = -1;
+  if (::close(fd) != 0) fail_write(target_, "write failed", errno);
+  if (::rename(temporary_.c_str(), target_.c_str()) != 0)
+    fail_write(target_, "cannot rename into place", errno);
+  committed_ = true;
+}
+
+}  // namespace g2s

@@ -1,0 +1,73 @@
+// MappedFile: maps an input file read-only (MAP_POPULATE, sequential advice) so the readers can
+// parse it in place; falls back to read() for files whose size stat does not know. Every OS
+// failure becomes Error(bad_input, "<file>: <what>: <strerror>").
+#include "io/mapped_file.hpp"
+
+#include <fcntl.h>
+#include <fmt/core.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+#include "g2s/error.hpp"
+
+namespace g2s::io {
+namespace {
+
+[[noreturn]] void fail_errno(const std::string& name, const char* what, int err) {
+  throw Error(Exit::bad_input, fmt::format("{}: {}: {}", name, what, std::strerror(err)));
+}
+
+struct FdGuard {
+  int fd;
+  ~FdGuard() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+}  // namespace
+
+MappedFile::MappedFile(const std::filesystem::path& path) : name_(path.string()) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) fail_errno(name_, "cannot open", errno);
+  FdGuard guard{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) fail_errno(name_, "cannot stat", errno);
+  if (S_ISDIR(st.st_mode)) {
+    throw Error(Exit::bad_input, fmt::format("{}: is a directory, expected a file", name_));
+  }
+  if (S_ISREG(st.st_mode) && st.st_size > 0) {
+    size_ = static_cast<std::size_t>(st.st_size);
+    void* map = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+    if (map == MAP_FAILED) fail_errno(name_, "cannot map", errno);
+    ::madvise(map, size_, MADV_SEQUENTIAL);
+    map_ = map;
+    data_ = static_cast<const char*>(map);
+    return;
+  }
+  // Pipes, character devices and files whose stat size is 0 (/proc): read to the end.
+  std::size_t used = 0;
+  copy_.resize(1 << 16);
+  for (;;) {
+    if (used == copy_.size()) copy_.resize(copy_.size() * 2);
+    const ssize_t got = ::read(fd, copy_.data() + used, copy_.size() - used);
+    if (got < 0) {
+      if (errno == EINTR) continue;
+      fail_errno(name_, "cannot read", errno);
+    }
+    if (got == 0) break;
+    used += static_cast<std::size_t>(got);
+  }
+  copy_.resize(used);
+  data_ = copy_.data();
+  size_ = used;
+}
+
+MappedFile::~MappedFile() {
+  if (map_ != nullptr) ::munmap(map_, size_);
+}
+
+}  // namespace g2s::io

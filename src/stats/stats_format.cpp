@@ -1,0 +1,68 @@
+// MeshStats as JSON (for scripts and CI: one object, keys always in the same order) and as
+// aligned text (for people). Both list the same numbers under the same names.
+#include <fmt/core.h>
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "g2s/stats.hpp"
+
+namespace g2s {
+namespace {
+
+// The counts in report order: JSON key, label for people.
+struct Field {
+  std::string_view key;
+  std::string_view label;
+  std::uint64_t value;
+};
+
+std::vector<Field> fields(const MeshStats& s) {
+  std::vector<Field> out = {
+      {"triangles", "triangles", s.triangles},
+      {"vertices", "vertices", s.vertices},
+      {"degenerate_triangles", "degenerate triangles", s.degenerate_triangles},
+      {"duplicate_triangles", "duplicate triangles", s.duplicate_triangles},
+      {"non_manifold_edges", "non-manifold edges", s.non_manifold_edges},
+      {"non_manifold_vertices", "non-manifold vertices", s.non_manifold_vertices},
+      {"non_manifold_vertices_type1", "  type I (a fan closed)", s.non_manifold_vertices_type1},
+      {"non_manifold_vertices_type2", "  type II (all fans open)", s.non_manifold_vertices_type2},
+      {"boundary_edges", "boundary edges", s.boundary_edges},
+      {"holes", "holes", s.holes},
+      {"orientation_conflicts", "orientation conflicts", s.orientation_conflicts},
+      {"components", "components", s.components},
+  };
+  if (s.has_coverage) {
+    out.push_back({"input_points", "input points", s.input_points});
+    out.push_back({"covered_points", "covered points", s.covered_points});
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string stats_to_json(const MeshStats& stats) {
+  std::string out = "{";
+  const char* separator = "\n";
+  for (const Field& f : fields(stats)) {
+    out += fmt::format("{}  \"{}\": {}", separator, f.key, f.value);
+    separator = ",\n";
+  }
+  // {} prints the shortest decimal that reads back as the same double: valid JSON, no NaN.
+  if (stats.has_coverage) out += fmt::format(",\n  \"coverage\": {}", stats.coverage);
+  out += "\n}";
+  return out;
+}
+
+std::string stats_to_text(const MeshStats& stats) {
+  std::string out;
+  for (const Field& f : fields(stats)) out += fmt::format("{:<26}{:>14}\n", f.label, f.value);
+  if (stats.has_coverage) {
+    out += fmt::format("{:<26}{:>13.3f}%\n", "coverage", 100.0 * stats.coverage);
+  }
+  return out;
+}
+
+}  // namespace g2s

@@ -1,0 +1,36 @@
+// g2s: the command-line tool. A thin layer over include/g2s/: parse, call, report.
+#include <fmt/core.h>
+
+#include <exception>
+
+#include "commands.hpp"
+#include "g2s/error.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "g2s: fast manifold surface reconstruction of point clouds (G2S mesh growing).\n\n"
+      "Exit codes: 0 success; 1 internal error; 2 bad command line; 3 bad input (missing,\n"
+      "unreadable, malformed, no usable points); 4 output could not be written (missing or\n"
+      "read-only folder, disk full); 130 interrupted."};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "g2s 0.1.0");
+  g2s::cli::add_mesh_command(app);
+  g2s::cli::add_stats_command(app);
+  g2s::cli::add_synth_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : static_cast<int>(g2s::Exit::usage);
+  } catch (const g2s::Error& e) {
+    fmt::print(stderr, "g2s: error: {}\n", e.what());
+    return static_cast<int>(e.code());
+  } catch (const std::bad_alloc&) {
+    fmt::print(stderr, "g2s: error: out of memory\n");
+    return static_cast<int>(g2s::Exit::failure);
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "g2s: internal error: {}\n", e.what());
+    return static_cast<int>(g2s::Exit::failure);
+  }
+  return 0;
+}
