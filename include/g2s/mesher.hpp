@@ -23,7 +23,7 @@ struct MeshOptions {
   double max_fold_deg = 135.0;
   // No search ball is larger than this many spacings (the median nearest-neighbour distance):
   // fronts do not bridge voids, and a query never scans a large part of the cloud.
-  double max_radius = 10.0;
+  double max_radius = 6.0;
   // Seed search ball radius, in nearest-neighbour edge lengths (§3).
   double seed_ball = 2.5;
   // Orient each closed component outward (open ones away from the cloud centre).

@@ -24,7 +24,7 @@ std::uint64_t orient_components(std::vector<Triangle>& triangles,
   std::iota(parent.begin(), parent.end(), 0u);
   // Per triangle: edges it opened minus edges it closed; a component is closed when they cancel.
   std::vector<std::int64_t> open_balance(nt, 0);
-  EdgeMap edges(std::size_t{3} * nt / 2 + 16);
+  EdgeMap edges(positions.size());
   for (std::uint32_t t = 0; t < nt; ++t) {
     for (int k = 0; k < 3; ++k) {
       const Index u = triangles[t][k], v = triangles[t][(k + 1) % 3];

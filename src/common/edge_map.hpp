@@ -16,11 +16,13 @@ class EdgeMap {
   static constexpr std::uint32_t kClosed = 0x80000000u;  // value flag: edge has two triangles
   static constexpr std::uint32_t kMissing = 0xFFFFFFFFu;
 
-  explicit EdgeMap(std::size_t expected_edges = 0) { reset(expected_edges); }
+  // vertex_count: vertices are 0..vertex_count-1.
+  explicit EdgeMap(std::size_t vertex_count = 0) { reset(vertex_count); }
 
-  void reset(std::size_t expected_edges) {
+  void reset(std::size_t vertex_count) {
     std::size_t slots = 64;
-    while (slots * 5 < expected_edges * 8) slots *= 2;  // load factor <= 0.625
+    // A triangulated surface has about 3 edges per vertex; keep the load factor under 5/8.
+    while (slots * 5 < vertex_count * 3 * 8) slots *= 2;
     keys_.assign(slots, kEmpty);
     values_.assign(slots, kMissing);
     mask_ = slots - 1;

@@ -45,8 +45,9 @@ inline bool circumball(const Vec3& a, const Vec3& b, const Vec3& c, Ball& out) {
   const double w2 = norm2(w);
   const double uu = norm2(u);
   const double vv = norm2(v);
-  // Reject slivers whose circumcentre is numerically meaningless.
-  if (!(w2 > 1e-12 * uu * vv)) return false;
+  // Reject slivers (smallest angle below ~0.006 degrees): their circumcentre is numerically
+  // meaningless and, written out, they may become exactly collinear.
+  if (!(w2 > 1e-8 * uu * vv)) return false;
   const Vec3 offset = (cross(w, u) * vv + cross(v, w) * uu) * (0.5 / w2);
   out.centre = a + offset;
   out.radius2 = norm2(offset);

@@ -2,6 +2,7 @@
 // order of their cells, duplicates merged, and the cell hash filled. See hash_grid.hpp.
 #include "grid/hash_grid.hpp"
 
+#include <bit>
 #include <numeric>
 
 namespace g2s {
@@ -66,15 +67,16 @@ HashGrid::HashGrid(std::span<const float> xyz, std::span<const Index> ids) {
   // A surface spanning the box has an area of the order of its largest faces.
   double area = dx * dy + dy * dz + dz * dx;
   if (!(area > 0)) area = extent * extent;
-  double cell = n > 1 && area > 0 ? 2.0 * std::sqrt(area / static_cast<double>(n)) : 1.0;
+  double cell = n > 1 && area > 0 ? 3.0 * std::sqrt(area / static_cast<double>(n)) : 1.0;
   const double min_cell = extent > 0 ? extent / static_cast<double>(kMaxDim) : 1.0;
 
   build(xyz, ids, std::max(cell, min_cell));
   spacing_ = estimate_spacing();
-  // Aim for a cell edge of about two spacings: a front search ball then spans about two cells
-  // per axis and a cell holds a handful of surface points.
+  // Aim for a cell edge of about three spacings: a front search ball (radius about one edge,
+  // which on noisy scans is often twice the nearest-neighbour distance) then spans about two
+  // cells per axis, and a cell holds about ten surface points, scanned sequentially.
   if (spacing_ > 0) {
-    const double wanted = std::max(2.0 * spacing_, min_cell);
+    const double wanted = std::max(3.0 * spacing_, min_cell);
     if (wanted < 0.7 * cell_ || wanted > 1.4 * cell_) {
       build(xyz, ids, wanted);
       spacing_ = estimate_spacing();
@@ -147,10 +149,11 @@ void HashGrid::build(std::span<const float> xyz, std::span<const Index> ids, dou
   std::size_t slots = 16;
   while (slots < 2 * cell_codes.size()) slots *= 2;
   slot_mask_ = slots - 1;
+  slot_shift_ = 64 - std::countr_zero(slots);
   slot_code_.assign(slots, kEmpty);
   slot_cell_.assign(slots, kNoIndex);
   for (std::uint32_t c = 0; c < cell_codes.size(); ++c) {
-    std::uint64_t slot = (cell_codes[c] * 0x9E3779B97F4A7C15ull) >> 20 & slot_mask_;
+    std::uint64_t slot = (cell_codes[c] * 0x9E3779B97F4A7C15ull) >> slot_shift_;
     while (slot_code_[slot] != kEmpty) slot = (slot + 1) & slot_mask_;
     slot_code_[slot] = cell_codes[c];
     slot_cell_[slot] = c;

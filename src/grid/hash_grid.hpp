@@ -54,6 +54,7 @@ class HashGrid {
   std::vector<std::uint64_t> slot_code_;   // hash slots: Morton code of the cell, or kEmpty
   std::vector<std::uint32_t> slot_cell_;   // hash slots: cell index
   std::uint64_t slot_mask_ = 0;
+  int slot_shift_ = 60;  // 64 - log2(slots): the top bits of the product are the best mixed
   double origin_[3] = {0, 0, 0};
   double cell_ = 1.0;
   double inv_cell_ = 1.0;
@@ -77,7 +78,7 @@ inline std::uint64_t morton3(std::uint64_t x, std::uint64_t y, std::uint64_t z) 
 }
 
 inline std::uint32_t HashGrid::find_cell(std::uint64_t code) const {
-  std::uint64_t slot = (code * 0x9E3779B97F4A7C15ull) >> 20 & slot_mask_;
+  std::uint64_t slot = (code * 0x9E3779B97F4A7C15ull) >> slot_shift_;
   for (;;) {
     const std::uint64_t c = slot_code_[slot];
     if (c == code) return slot_cell_[slot];
@@ -89,17 +90,32 @@ inline std::uint32_t HashGrid::find_cell(std::uint64_t code) const {
 template <class Visit>
 void HashGrid::for_each_in_ball(const Vec3& centre, double radius, Visit&& visit) const {
   const double r2 = radius * radius;
-  std::int64_t lo[3], hi[3];
-  const double c[3] = {centre.x, centre.y, centre.z};
-  for (int a = 0; a < 3; ++a) {
-    lo[a] = std::max<std::int64_t>(cell_coord(c[a] - radius, a), 0);
-    hi[a] = std::min<std::int64_t>(cell_coord(c[a] + radius, a), dims_[a] - 1);
-    if (lo[a] > hi[a]) return;
-  }
-  for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
-    for (std::int64_t y = lo[1]; y <= hi[1]; ++y) {
-      for (std::int64_t x = lo[0]; x <= hi[0]; ++x) {
-        const std::uint32_t cell = find_cell(morton3(x, y, z));
+  // Only the cells the ball touches: per z slab and y row, the x range shrinks to the ball's
+  // chord there, so a large ball visits about half the cells of its bounding cube.
+  auto gap = [&](std::int64_t cell, double c, int axis) {  // distance from c to a cell's span
+    const double lo = origin_[axis] + static_cast<double>(cell) * cell_;
+    return c < lo ? lo - c : std::max(0.0, c - (lo + cell_));
+  };
+  const std::int64_t z0 = std::max<std::int64_t>(cell_coord(centre.z - radius, 2), 0);
+  const std::int64_t z1 = std::min<std::int64_t>(cell_coord(centre.z + radius, 2), dims_[2] - 1);
+  for (std::int64_t z = z0; z <= z1; ++z) {
+    const double gz = gap(z, centre.z, 2);
+    const double rz2 = r2 - gz * gz;
+    if (rz2 < 0) continue;
+    const double rz = std::sqrt(rz2);
+    const std::int64_t y0 = std::max<std::int64_t>(cell_coord(centre.y - rz, 1), 0);
+    const std::int64_t y1 = std::min<std::int64_t>(cell_coord(centre.y + rz, 1), dims_[1] - 1);
+    for (std::int64_t y = y0; y <= y1; ++y) {
+      const double gy = gap(y, centre.y, 1);
+      const double ry2 = rz2 - gy * gy;
+      if (ry2 < 0) continue;
+      const double ry = std::sqrt(ry2);
+      const std::int64_t x0 = std::max<std::int64_t>(cell_coord(centre.x - ry, 0), 0);
+      const std::int64_t x1 = std::min<std::int64_t>(cell_coord(centre.x + ry, 0), dims_[0] - 1);
+      for (std::int64_t x = x0; x <= x1; ++x) {
+        const std::uint32_t cell = find_cell(morton3(static_cast<std::uint64_t>(x),
+                                                     static_cast<std::uint64_t>(y),
+                                                     static_cast<std::uint64_t>(z)));
         if (cell == kNoIndex) continue;
         for (std::uint32_t i = cell_start_[cell], end = cell_start_[cell + 1]; i < end; ++i) {
           const Vec3f& p = points_[i];

@@ -24,6 +24,12 @@ struct FrontEdge {
   Index cand;
 };
 
+struct PoolPoint {
+  Index index;
+  double dist2;  // squared distance to the edge midpoint
+  double ahead;  // distance along the growing direction
+};
+
 struct Candidate {
   Index point = kNoIndex;
   int priority = 0;
@@ -47,7 +53,7 @@ class Grower {
         options_(options),
         levels_(static_cast<int>(options.radius_steps.size())),
         flat_levels_(std::max(1, options.flatness_levels)),
-        edges_(std::size_t{3} * grid.size()),
+        edges_(grid.size()),
         used_(grid.size(), 0),
         seed_tried_(grid.size(), 0),
         open_count_(grid.size(), 0),
@@ -143,7 +149,13 @@ class Grower {
     Index p = cand_[start];
     for (std::size_t step = 0; step <= cand_.size(); ++step) {
       Ball ball;
-      if (!circumball(a, b, grid_.position(p), ball)) return kNoIndex;
+      if (!circumball(a, b, grid_.position(p), ball)) {
+        // (Nearly) on the line ab: no triangle. Walk on among the others.
+        cand_.erase(std::find(cand_.begin(), cand_.end(), p));
+        if (cand_.empty()) return kNoIndex;
+        p = cand_.front();
+        continue;
+      }
       const double tol = 1e-6 * ball.radius2;
       Index next = kNoIndex;
       double deepest = 0;
@@ -160,27 +172,48 @@ class Grower {
   }
 
   // The point to grow edge e onto, and its priority value m*(radius level) + flatness level.
+  // The search balls of all levels pass through a and b with centres on the same ray, so on the
+  // growing side each contains the one before: the level-1 ball is gathered first (most edges
+  // stop there), then, if needed, the largest once, and each level filters it by its own ball.
   Candidate find_candidate(const FrontEdge& e) {
     const Index c = apex(triangles_[e.triangle], e.a, e.b);
     const Vec3 a = grid_.position(e.a), b = grid_.position(e.b), pc = grid_.position(c);
     const Vec3 n = normalized(cross(b - a, pc - a));
     const Vec3 ab = b - a;
     const double len = norm(ab);
+    if (len >= radius_cap_) return {};
     const Vec3 mid = (a + b) * 0.5;
     const Vec3 out = normalized(cross(ab, n));
     const double base = std::max(len, radius_floor_);
-    if (len >= radius_cap_) return {};
-    for (int level = 0; level < levels_; ++level) {
+    auto ball_of = [&](int level, double& along) {
       const double radius =
           std::min(options_.radius_steps[static_cast<std::size_t>(level)] * base, radius_cap_);
-      const double along = std::sqrt(std::max(radius * radius - 0.25 * len * len, 0.0));
-      cand_.clear();
+      along = std::sqrt(std::max(radius * radius - 0.25 * len * len, 0.0));
+      return radius;
+    };
+    auto gather = [&](int level) {
+      double along = 0;
+      const double radius = ball_of(level, along);
+      pool_.clear();
       grid_.for_each_in_ball(mid + out * along, radius, [&](std::uint32_t j, double) {
         if (j == e.a || j == e.b || j == c || interior(j)) return;
-        if (dot(grid_.position(j) - mid, out) <= 0) return;
+        const Vec3 d = grid_.position(j) - mid;
+        const double ahead = dot(d, out);
+        if (ahead <= 0) return;
         if (std::find(excluded_.begin(), excluded_.end(), j) != excluded_.end()) return;
-        cand_.push_back(j);
+        pool_.push_back({j, norm2(d), ahead});
       });
+    };
+    gather(0);
+    for (int level = 0; level < levels_; ++level) {
+      if (level == 1) gather(levels_ - 1);
+      double along = 0;
+      ball_of(level, along);
+      // Inside this level's ball: |q - mid - along*out|^2 <= radius^2 = along^2 + len^2/4.
+      cand_.clear();
+      for (const PoolPoint& q : pool_) {
+        if (q.dist2 - 2 * along * q.ahead <= 0.25 * len * len) cand_.push_back(q.index);
+      }
       while (!cand_.empty()) {
         const Index p = gabriel_walk(a, b, mid);
         if (p == kNoIndex) break;
@@ -292,6 +325,7 @@ class Grower {
   const double radius_floor_;
   const double radius_cap_;
   // Scratch, reused across edges so the inner loop does not allocate.
+  std::vector<PoolPoint> pool_;
   std::vector<Index> cand_;
   std::vector<Index> excluded_;
   std::vector<std::pair<double, std::uint32_t>> near_;

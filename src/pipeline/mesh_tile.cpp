@@ -18,8 +18,9 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }
 
 // Edges used by exactly one triangle, as that triangle traverses them.
-std::vector<std::array<Index, 2>> open_edges_of(const std::vector<Triangle>& triangles) {
-  EdgeMap edges(std::size_t{3} * triangles.size() / 2 + 16);
+std::vector<std::array<Index, 2>> open_edges_of(const std::vector<Triangle>& triangles,
+                                                std::size_t vertex_count) {
+  EdgeMap edges(vertex_count);
   for (std::uint32_t t = 0; t < triangles.size(); ++t) {
     for (int k = 0; k < 3; ++k) edges.add(triangles[t][k], triangles[t][(k + 1) % 3], t);
   }
@@ -65,7 +66,7 @@ TileMesh mesh_tile(std::span<const float> xyz, std::span<const Index> ids,
   out.report.triangles_removed = nm.triangles_removed;
   out.report.non_manifold_vertices_fixed = nm.vertices_fixed;
   if (options.orient) out.report.components_flipped = orient_components(triangles, grid.points());
-  out.open_edges = open_edges_of(triangles);
+  out.open_edges = open_edges_of(triangles, grid.size());
   for (Triangle& t : triangles) {
     for (Index& v : t) v = grid.id(v);
   }

@@ -147,7 +147,7 @@ bool is_degenerate(const Triangle& t, const Triangle& input, const double* xyz) 
 
 // Welds the corners by exact position and drops (and counts) degenerate triangles. The position
 // table holds (32 hash bits << 32 | welded id) so that probing rarely touches the coordinates;
-// it starts small (STL soups hold each position about six times) and doubles as it fills.
+// it is sized for min(input vertices, triangles) and doubles if more positions turn up.
 Welded weld(const IndexedMesh& mesh, MeshStats& stats) {
   const std::size_t n = mesh.vertex_count();
   const std::size_t count = mesh.triangles.size();
