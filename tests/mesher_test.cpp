@@ -1,0 +1,344 @@
+// End-to-end tests of the mesher through the public API (include/g2s/mesher.hpp): mesh quality on
+// synthetic shapes measured with compute_stats (ALGORITHM.md §8), determinism and independence
+// from the input order, duplicate merging, degenerate inputs, georeferenced coordinates and the
+// open front edges handed to the stitcher.
+#include "g2s/mesher.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <map>
+#include <numeric>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "g2s/stats.hpp"
+#include "g2s/synth.hpp"
+
+namespace {
+
+using g2s::Index;
+using g2s::IndexedMesh;
+using g2s::MeshStats;
+using g2s::PointCloud;
+using g2s::SynthShape;
+using g2s::TileMesh;
+using g2s::Triangle;
+
+PointCloud synth(SynthShape shape, std::uint64_t points, std::uint64_t seed = 1) {
+  g2s::SynthOptions o;
+  o.shape = shape;
+  o.points = points;
+  o.seed = seed;
+  return g2s::make_synthetic_cloud(o);
+}
+
+MeshStats stats_of(const PointCloud& cloud, const std::vector<Triangle>& triangles) {
+  IndexedMesh mesh;
+  mesh.xyz = cloud.xyz;
+  mesh.triangles = triangles;
+  return g2s::compute_stats(mesh, &cloud);
+}
+
+// Signed volume of a mesh indexing cloud.xyz (positive: closed and facing outward), taken about
+// the first point so that georeferenced coordinates do not cancel catastrophically.
+double signed_volume(const PointCloud& cloud, const std::vector<Triangle>& triangles) {
+  double v = 0;
+  auto p = [&](Index i, int a) { return cloud.xyz[3 * std::size_t{i} + a] - cloud.xyz[a]; };
+  for (const Triangle& t : triangles) {
+    const double ax = p(t[0], 0), ay = p(t[0], 1), az = p(t[0], 2);
+    const double bx = p(t[1], 0), by = p(t[1], 1), bz = p(t[1], 2);
+    const double cx = p(t[2], 0), cy = p(t[2], 1), cz = p(t[2], 2);
+    v += ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx);
+  }
+  return v / 6;
+}
+
+// Prints and records the numbers that matter, so a failing or drifting run shows them.
+void report(const std::string& name, const TileMesh& mesh, const MeshStats& s) {
+  const double per_point = s.input_points ? double(s.triangles) / double(s.input_points) : 0.0;
+  std::printf(
+      "[%s] points %llu triangles %llu (%.4f/point) boundary %llu holes %llu components %llu "
+      "coverage %.4f%% nm-edges %llu nm-vertices %llu conflicts %llu dup %llu degen %llu | "
+      "seeds %llu removed %llu flipped %llu\n",
+      name.c_str(), static_cast<unsigned long long>(s.input_points),
+      static_cast<unsigned long long>(s.triangles), per_point,
+      static_cast<unsigned long long>(s.boundary_edges), static_cast<unsigned long long>(s.holes),
+      static_cast<unsigned long long>(s.components), 100 * s.coverage,
+      static_cast<unsigned long long>(s.non_manifold_edges),
+      static_cast<unsigned long long>(s.non_manifold_vertices),
+      static_cast<unsigned long long>(s.orientation_conflicts),
+      static_cast<unsigned long long>(s.duplicate_triangles),
+      static_cast<unsigned long long>(s.degenerate_triangles),
+      static_cast<unsigned long long>(mesh.report.seeds),
+      static_cast<unsigned long long>(mesh.report.triangles_removed),
+      static_cast<unsigned long long>(mesh.report.components_flipped));
+  const auto* info = testing::UnitTest::GetInstance()->current_test_info();
+  if (info == nullptr) return;
+  testing::Test::RecordProperty(name + "_triangles", std::to_string(s.triangles));
+  testing::Test::RecordProperty(name + "_boundary_edges", std::to_string(s.boundary_edges));
+  testing::Test::RecordProperty(name + "_holes", std::to_string(s.holes));
+  testing::Test::RecordProperty(name + "_components", std::to_string(s.components));
+  testing::Test::RecordProperty(name + "_coverage", std::to_string(s.coverage));
+}
+
+void expect_manifold(const MeshStats& s, const std::string& name) {
+  EXPECT_EQ(s.non_manifold_edges, 0u) << name;
+  EXPECT_EQ(s.non_manifold_vertices, 0u) << name;
+  EXPECT_EQ(s.orientation_conflicts, 0u) << name;
+  EXPECT_EQ(s.duplicate_triangles, 0u) << name;
+  EXPECT_EQ(s.degenerate_triangles, 0u) << name;
+}
+
+void expect_good_closed_surface(SynthShape shape, const std::string& name) {
+  const PointCloud cloud = synth(shape, 20'000);
+  const TileMesh mesh = g2s::mesh_cloud(cloud, {});
+  const MeshStats s = stats_of(cloud, mesh.triangles);
+  report(name, mesh, s);
+  expect_manifold(s, name);
+  const double per_point = double(s.triangles) / double(cloud.size());
+  EXPECT_GE(per_point, 1.9) << name;
+  EXPECT_LE(per_point, 2.02) << name;
+  // Measured: BOUNDARY_MEASURE.
+  EXPECT_LE(s.boundary_edges, s.triangles / 100) << name;
+  EXPECT_GE(s.coverage, 0.995) << name;
+  EXPECT_EQ(s.components, 1u) << name;
+  EXPECT_GT(signed_volume(cloud, mesh.triangles), 0) << name << ": faces inward";
+  EXPECT_EQ(mesh.open_edges.size(), s.boundary_edges) << name;
+  EXPECT_EQ(mesh.report.points, cloud.size());
+  EXPECT_EQ(mesh.report.duplicates_merged, 0u);
+}
+
+TEST(Mesher, SphereOf20kPointsIsAClosedManifoldFacingOutward) {
+  expect_good_closed_surface(SynthShape::sphere, "sphere");
+}
+
+TEST(Mesher, TorusOf20kPointsIsAClosedManifoldFacingOutward) {
+  expect_good_closed_surface(SynthShape::torus, "torus");
+}
+
+TEST(Mesher, TerrainIsAManifoldOpenSurfaceFacingUp) {
+  const PointCloud cloud = synth(SynthShape::terrain, 20'000);
+  const TileMesh mesh = g2s::mesh_cloud(cloud, {});
+  const MeshStats s = stats_of(cloud, mesh.triangles);
+  report("terrain", mesh, s);
+  expect_manifold(s, "terrain");
+  EXPECT_GE(s.coverage, 0.99);
+  EXPECT_EQ(s.components, 1u);
+  // A patch of V vertices and B boundary edges triangulated without holes has 2V - B - 2
+  // triangles.
+  EXPECT_GE(double(s.triangles), 0.98 * double(2 * s.vertices - s.boundary_edges - 2));
+  // Facing up: the area-weighted normal points to +z.
+  double nz = 0;
+  for (const Triangle& t : mesh.triangles) {
+    auto p = [&](int c, int a) { return cloud.xyz[3 * std::size_t{t[c]} + a]; };
+    nz += 0.5 * ((p(1, 0) - p(0, 0)) * (p(2, 1) - p(0, 1)) -
+                 (p(1, 1) - p(0, 1)) * (p(2, 0) - p(0, 0)));
+  }
+  EXPECT_GT(nz, 0.9);  // the patch covers [0,1]^2: about 1 when facing up, -1 when down
+}
+
+TEST(Mesher, OpenEdgesOfATerrainTileAreItsBoundaryEdges) {
+  const PointCloud cloud = synth(SynthShape::terrain, 10'000, 3);
+  const TileMesh mesh = g2s::mesh_cloud(cloud, {});
+  const MeshStats s = stats_of(cloud, mesh.triangles);
+  ASSERT_GT(s.boundary_edges, 0u);
+  EXPECT_EQ(mesh.open_edges.size(), s.boundary_edges);
+  // Each open edge a->b is traversed a->b by exactly one triangle and b->a by none.
+  std::map<std::pair<Index, Index>, int> directed;
+  for (const Triangle& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) ++directed[{t[k], t[(k + 1) % 3]}];
+  }
+  auto uses = [&](Index u, Index v) {
+    const auto it = directed.find({u, v});
+    return it == directed.end() ? 0 : it->second;
+  };
+  for (const auto& e : mesh.open_edges) {
+    EXPECT_EQ(uses(e[0], e[1]), 1) << e[0] << "->" << e[1];
+    EXPECT_EQ(uses(e[1], e[0]), 0) << e[0] << "->" << e[1];
+  }
+}
+
+void expect_manifold_hard_shape(SynthShape shape, const std::string& name) {
+  const PointCloud cloud = synth(shape, 20'000);
+  const TileMesh mesh = g2s::mesh_cloud(cloud, {});
+  const MeshStats s = stats_of(cloud, mesh.triangles);
+  report(name, mesh, s);
+  EXPECT_EQ(s.non_manifold_edges, 0u) << name;
+  EXPECT_EQ(s.non_manifold_vertices, 0u) << name;
+  EXPECT_EQ(s.orientation_conflicts, 0u) << name;
+  EXPECT_GT(s.triangles, cloud.size()) << name << ": meshed at all";
+}
+
+TEST(Mesher, CubeWithSharpEdgesHasNoNonManifoldEdgeVertexOrConflict) {
+  expect_manifold_hard_shape(SynthShape::cube, "cube");
+}
+
+TEST(Mesher, ThinPlateHasNoNonManifoldEdgeVertexOrConflict) {
+  expect_manifold_hard_shape(SynthShape::plate, "plate");
+}
+
+// --- determinism --------------------------------------------------------------------------------
+
+// Rotated so the smallest corner comes first: the same oriented triangle, whatever the start.
+Triangle canonical(Triangle t) {
+  const auto m = std::min_element(t.begin(), t.end()) - t.begin();
+  std::rotate(t.begin(), t.begin() + m, t.end());
+  return t;
+}
+
+std::vector<Triangle> canonical_set(std::vector<Triangle> t) {
+  for (auto& x : t) x = canonical(x);
+  std::sort(t.begin(), t.end());
+  return t;
+}
+
+std::vector<float> as_floats(const PointCloud& cloud) {
+  return std::vector<float>(cloud.xyz.begin(), cloud.xyz.end());
+}
+
+TEST(Mesher, MeshingTheSameCloudTwiceGivesIdenticalTriangles) {
+  const PointCloud cloud = synth(SynthShape::torus, 10'000, 7);
+  const TileMesh a = g2s::mesh_cloud(cloud, {});
+  const TileMesh b = g2s::mesh_cloud(cloud, {});
+  ASSERT_GT(a.triangles.size(), 19'000u);
+  EXPECT_EQ(a.triangles, b.triangles);
+  EXPECT_EQ(a.open_edges, b.open_edges);
+}
+
+TEST(Mesher, ShuffledInputWithPermutedIdsGivesTheSameTriangles) {
+  const PointCloud cloud = synth(SynthShape::sphere, 10'000, 5);
+  const std::vector<float> xyz = as_floats(cloud);
+  const TileMesh reference = g2s::mesh_tile(xyz, {}, {});
+  ASSERT_GT(reference.triangles.size(), 19'000u);
+  std::mt19937_64 rng(42);
+  for (int round = 0; round < 2; ++round) {
+    std::vector<Index> perm(cloud.size());
+    std::iota(perm.begin(), perm.end(), 0u);
+    std::shuffle(perm.begin(), perm.end(), rng);
+    std::vector<float> shuffled;
+    shuffled.reserve(xyz.size());
+    for (Index k : perm) shuffled.insert(shuffled.end(), xyz.begin() + 3 * k, xyz.begin() + 3 * k + 3);
+    const TileMesh mesh = g2s::mesh_tile(shuffled, perm, {});
+    EXPECT_EQ(canonical_set(mesh.triangles), canonical_set(reference.triangles));
+    // The documented promise is stronger: the result does not depend on the order at all.
+    EXPECT_EQ(mesh.triangles, reference.triangles);
+  }
+}
+
+TEST(Mesher, EveryPointDoubledGivesTheSameTrianglesAndCountsTheDuplicates) {
+  const PointCloud cloud = synth(SynthShape::sphere, 5'000, 9);
+  PointCloud doubled = cloud;
+  doubled.xyz.insert(doubled.xyz.end(), cloud.xyz.begin(), cloud.xyz.end());
+  const TileMesh single = g2s::mesh_cloud(cloud, {});
+  const TileMesh twice = g2s::mesh_cloud(doubled, {});
+  EXPECT_EQ(twice.report.duplicates_merged, cloud.size());
+  EXPECT_EQ(twice.report.points, doubled.size());
+  ASSERT_GT(single.triangles.size(), 9'000u);
+  // The copies kept are the first (smaller ids), so the triangles are literally the same.
+  EXPECT_EQ(twice.triangles, single.triangles);
+}
+
+// --- degenerate inputs --------------------------------------------------------------------------
+
+// Whatever comes out must be a valid mesh over the given points.
+void expect_valid(const PointCloud& cloud, const TileMesh& mesh, const std::string& name) {
+  for (const Triangle& t : mesh.triangles) {
+    for (Index v : t) ASSERT_LT(v, cloud.size()) << name;
+  }
+  if (mesh.triangles.empty()) return;
+  const MeshStats s = stats_of(cloud, mesh.triangles);
+  expect_manifold(s, name);
+}
+
+PointCloud from_points(const std::vector<std::array<double, 3>>& points) {
+  PointCloud c;
+  for (const auto& p : points) c.xyz.insert(c.xyz.end(), p.begin(), p.end());
+  return c;
+}
+
+TEST(Mesher, TinyAndDegenerateCloudsGiveNoTriangles) {
+  const std::vector<std::pair<std::string, PointCloud>> clouds{
+      {"empty", PointCloud{}},
+      {"one point", from_points({{1, 2, 3}})},
+      {"two points", from_points({{1, 2, 3}, {2, 2, 3}})},
+      {"three collinear", from_points({{0, 0, 0}, {1, 1, 1}, {2, 2, 2}})},
+      {"two identical + one", from_points({{0, 0, 0}, {0, 0, 0}, {1, 0, 0}})},
+  };
+  for (const auto& [name, cloud] : clouds) {
+    const TileMesh mesh = g2s::mesh_cloud(cloud, {});
+    EXPECT_TRUE(mesh.triangles.empty()) << name;
+    EXPECT_TRUE(mesh.open_edges.empty()) << name;
+    EXPECT_EQ(mesh.report.points, cloud.size()) << name;
+  }
+  // The empty span through mesh_tile as well.
+  const TileMesh empty = g2s::mesh_tile(std::span<const float>{}, {}, {});
+  EXPECT_TRUE(empty.triangles.empty());
+}
+
+TEST(Mesher, ThreePointsInGeneralPositionGiveOneTriangle) {
+  const PointCloud cloud = from_points({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}});
+  const TileMesh mesh = g2s::mesh_cloud(cloud, {});
+  ASSERT_EQ(mesh.triangles.size(), 1u);
+  EXPECT_EQ(canonical_set(mesh.triangles), (std::vector<Triangle>{{0, 1, 2}}));  // faces +z
+  EXPECT_EQ(mesh.open_edges.size(), 3u);
+}
+
+TEST(Mesher, AllPointsIdenticalGiveNoTriangles) {
+  PointCloud cloud;
+  for (int i = 0; i < 1000; ++i) cloud.xyz.insert(cloud.xyz.end(), {4.5, -1.25, 3.0});
+  const TileMesh mesh = g2s::mesh_cloud(cloud, {});
+  EXPECT_TRUE(mesh.triangles.empty());
+  EXPECT_EQ(mesh.report.duplicates_merged, 999u);
+}
+
+TEST(Mesher, ThousandCollinearPointsGiveNoTriangles) {
+  PointCloud cloud;
+  for (int i = 0; i < 1000; ++i) cloud.xyz.insert(cloud.xyz.end(), {0.5 * i, 0.25 * i, -0.1 * i});
+  const TileMesh mesh = g2s::mesh_cloud(cloud, {});
+  expect_valid(cloud, mesh, "collinear");
+  EXPECT_TRUE(mesh.triangles.empty());
+}
+
+TEST(Mesher, ThousandCoplanarGridPointsAreMeshed) {
+  // 40 x 25 lattice: every quad's four corners are co-circular, the tie-break case of §1.
+  PointCloud cloud;
+  for (int j = 0; j < 25; ++j) {
+    for (int i = 0; i < 40; ++i) cloud.xyz.insert(cloud.xyz.end(), {0.1 * i, 0.1 * j, 2.0});
+  }
+  const TileMesh mesh = g2s::mesh_cloud(cloud, {});
+  const MeshStats s = stats_of(cloud, mesh.triangles);
+  report("grid", mesh, s);
+  expect_manifold(s, "grid");
+  EXPECT_GT(s.triangles, 1800u);  // a full triangulation has 2 * 39 * 24 = 1872
+  EXPECT_LE(s.triangles, 1872u);
+  EXPECT_EQ(s.components, 1u);
+}
+
+TEST(Mesher, GeoreferencedCoordinatesMeshLikeTheSameCloudAtTheOrigin) {
+  const PointCloud at_origin = synth(SynthShape::sphere, 10'000, 11);
+  PointCloud far = at_origin;
+  for (std::size_t i = 0; i < far.size(); ++i) {
+    far.xyz[3 * i] += 1e7;
+    far.xyz[3 * i + 1] += 1e7;
+  }
+  const TileMesh near_mesh = g2s::mesh_cloud(at_origin, {});
+  const TileMesh far_mesh = g2s::mesh_cloud(far, {});
+  const auto n0 = double(near_mesh.triangles.size()), n1 = double(far_mesh.triangles.size());
+  std::printf("[georeferenced] triangles at origin %.0f, at 1e7: %.0f\n", n0, n1);
+  ASSERT_GT(n0, 19'000);
+  EXPECT_NEAR(n1, n0, 0.01 * n0);
+  IndexedMesh mesh;
+  mesh.xyz = far.xyz;
+  mesh.triangles = far_mesh.triangles;
+  const MeshStats s = g2s::compute_stats(mesh);
+  expect_manifold(s, "georeferenced");
+  EXPECT_GT(signed_volume(far, far_mesh.triangles), 0);
+}
+
+}  // namespace

