@@ -56,8 +56,8 @@ class Progress {
 void run_mesh(MeshArgs& args) {
   std::unique_ptr<tbb::global_control> threads;
   if (args.threads > 0) {
-    threads = std::make_unique<tbb::global_control>(
-        tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(args.threads));
+    threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                    static_cast<std::size_t>(args.threads));
   }
   Progress progress(!args.quiet && !args.json);
   const auto t0 = std::chrono::steady_clock::now();
@@ -65,9 +65,9 @@ void run_mesh(MeshArgs& args) {
   ReadReport read_report;
   PointCloud cloud = read_points(args.input, &read_report);
   if (cloud.size() == 0) {
-    throw Error(Exit::bad_input, fmt::format("{}: no usable points ({} read, {} non-finite)",
-                                             args.input, read_report.points + read_report.non_finite,
-                                             read_report.non_finite));
+    throw Error(Exit::bad_input,
+                fmt::format("{}: no usable points ({} read, {} non-finite)", args.input,
+                            read_report.points + read_report.non_finite, read_report.non_finite));
   }
   args.options.progress = [&](std::uint64_t used, std::uint64_t total) {
     progress.stage("meshing", static_cast<double>(used) / static_cast<double>(total));
@@ -80,8 +80,7 @@ void run_mesh(MeshArgs& args) {
                             args.input, cloud.size()));
   }
   progress.stage("writing", 1);
-  write_mesh(args.output, cloud.xyz, mesh.triangles,
-             mesh_format_for(args.output, args.ascii));
+  write_mesh(args.output, cloud.xyz, mesh.triangles, mesh_format_for(args.output, args.ascii));
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   progress.clear();
@@ -100,24 +99,23 @@ void run_mesh(MeshArgs& args) {
         "\"triangles_removed\":{},\"seconds\":{:.3f},\"seconds_grid\":{:.3f},"
         "\"seconds_grow\":{:.3f},\"seconds_cleanup\":{:.3f},\"ktriangles_per_second\":{:.1f},"
         "\"peak_rss_mb\":{:.1f}",
-        args.input, args.output, r.points, read_report.non_finite, r.duplicates_merged,
-        r.spacing, r.seeds, r.triangles_grown - r.triangles_removed, r.triangles_removed,
-        seconds, r.seconds_grid, r.seconds_grow, r.seconds_cleanup, ktps, peak_rss_mb());
+        args.input, args.output, r.points, read_report.non_finite, r.duplicates_merged, r.spacing,
+        r.seeds, r.triangles_grown - r.triangles_removed, r.triangles_removed, seconds,
+        r.seconds_grid, r.seconds_grow, r.seconds_cleanup, ktps, peak_rss_mb());
     if (!args.no_stats) fmt::print(",\"stats\":{}", stats_to_json(stats));
     fmt::print("}}\n");
     return;
   }
   if (args.quiet) return;
-  fmt::print(stderr,
-             "{}: {} points -> {} triangles in {:.2f} s ({:.0f} k triangles/s), peak {:.0f} MB",
-             args.output, r.points, r.triangles_grown - r.triangles_removed, seconds, ktps,
-             peak_rss_mb());
+  fmt::print(
+      stderr, "{}: {} points -> {} triangles in {:.2f} s ({:.0f} k triangles/s), peak {:.0f} MB",
+      args.output, r.points, r.triangles_grown - r.triangles_removed, seconds, ktps, peak_rss_mb());
   if (!args.no_stats) {
     fmt::print(stderr,
                "; non-manifold edges {}, non-manifold vertices {}, orientation conflicts {}, "
                "boundary edges {}, holes {}",
-               stats.non_manifold_edges, stats.non_manifold_vertices,
-               stats.orientation_conflicts, stats.boundary_edges, stats.holes);
+               stats.non_manifold_edges, stats.non_manifold_vertices, stats.orientation_conflicts,
+               stats.boundary_edges, stats.holes);
   }
   fmt::print(stderr, "\n");
 }
@@ -151,8 +149,9 @@ void add_mesh_command(CLI::App& app) {
                   "Largest angle in degrees between neighbouring triangle normals (default 135); "
                   "lower it on noisy scans to avoid folds, raise it for very sharp edges")
       ->check(CLI::Range(10.0, 179.0));
-  cmd->add_flag("--no-orient", [args](std::int64_t) { args->options.orient = false; },
-                "Keep each component's seed orientation instead of facing closed ones outward");
+  cmd->add_flag(
+      "--no-orient", [args](std::int64_t) { args->options.orient = false; },
+      "Keep each component's seed orientation instead of facing closed ones outward");
   cmd->callback([args] { run_mesh(*args); });
 }
 

@@ -34,11 +34,11 @@ struct MeshOptions {
 
 // Counts from one run, for the CLI summary, --json and the tests.
 struct MeshReport {
-  std::uint64_t points = 0;              // points given
-  std::uint64_t duplicates_merged = 0;   // exact duplicates left out of meshing
-  std::uint64_t seeds = 0;               // seed triangles (front components) grown
-  std::uint64_t triangles_grown = 0;     // before the non-manifold pass
-  std::uint64_t triangles_removed = 0;   // by the non-manifold pass
+  std::uint64_t points = 0;             // points given
+  std::uint64_t duplicates_merged = 0;  // exact duplicates left out of meshing
+  std::uint64_t seeds = 0;              // seed triangles (front components) grown
+  std::uint64_t triangles_grown = 0;    // before the non-manifold pass
+  std::uint64_t triangles_removed = 0;  // by the non-manifold pass
   std::uint64_t non_manifold_vertices_fixed = 0;
   std::uint64_t components_flipped = 0;  // components reoriented at the end
   double spacing = 0.0;                  // estimated mean nearest-neighbour spacing
@@ -48,8 +48,9 @@ struct MeshReport {
 };
 
 struct TileMesh {
-  std::vector<Triangle> triangles;              // in global ids
-  std::vector<std::array<Index, 2>> open_edges;  // boundary edges a->b as traversed by their triangle
+  std::vector<Triangle> triangles;  // in global ids
+  std::vector<std::array<Index, 2>>
+      open_edges;  // boundary edges a->b as traversed by their triangle
   MeshReport report;
 };
 

@@ -26,7 +26,6 @@ NonManifoldReport remove_non_manifold_vertices(std::vector<Triangle>& triangles,
 // volume), and open ones whose mean normal is mostly vertical face up (+z, aerial scans), the
 // others away from their centroid. Triangles must be consistently oriented within a component.
 // Returns the number of components flipped.
-std::uint64_t orient_components(std::vector<Triangle>& triangles,
-                                std::span<const Vec3f> positions);
+std::uint64_t orient_components(std::vector<Triangle>& triangles, std::span<const Vec3f> positions);
 
 }  // namespace g2s

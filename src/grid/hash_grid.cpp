@@ -169,8 +169,7 @@ double HashGrid::estimate_spacing() const {
   std::vector<double> d;
   d.reserve(samples);
   for (std::uint32_t s = 0; s < samples; ++s) {
-    const std::uint32_t i =
-        static_cast<std::uint32_t>(static_cast<std::uint64_t>(s) * n / samples);
+    const std::uint32_t i = static_cast<std::uint32_t>(static_cast<std::uint64_t>(s) * n / samples);
     const std::uint32_t j = nearest(i, max_radius, [](std::uint32_t) { return true; });
     if (j != kNoIndex) d.push_back(std::sqrt(norm2(position(i) - position(j))));
   }

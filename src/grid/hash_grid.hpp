@@ -113,9 +113,9 @@ void HashGrid::for_each_in_ball(const Vec3& centre, double radius, Visit&& visit
       const std::int64_t x0 = std::max<std::int64_t>(cell_coord(centre.x - ry, 0), 0);
       const std::int64_t x1 = std::min<std::int64_t>(cell_coord(centre.x + ry, 0), dims_[0] - 1);
       for (std::int64_t x = x0; x <= x1; ++x) {
-        const std::uint32_t cell = find_cell(morton3(static_cast<std::uint64_t>(x),
-                                                     static_cast<std::uint64_t>(y),
-                                                     static_cast<std::uint64_t>(z)));
+        const std::uint32_t cell =
+            find_cell(morton3(static_cast<std::uint64_t>(x), static_cast<std::uint64_t>(y),
+                              static_cast<std::uint64_t>(z)));
         if (cell == kNoIndex) continue;
         for (std::uint32_t i = cell_start_[cell], end = cell_start_[cell + 1]; i < end; ++i) {
           const Vec3f& p = points_[i];

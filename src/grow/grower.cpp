@@ -10,8 +10,8 @@
 #include <cmath>
 #include <numbers>
 
-#include "grow/bucket_queue.hpp"
 #include "common/edge_map.hpp"
+#include "grow/bucket_queue.hpp"
 
 namespace g2s {
 namespace {
@@ -217,8 +217,8 @@ class Grower {
         const Vec3 n_new = normalized(cross(a - b, grid_.position(p) - b));
         const double beta = std::acos(std::clamp(dot(n, n_new), -1.0, 1.0));
         if (beta <= max_fold_) {
-          const int flat = std::min(flat_levels_ - 1, static_cast<int>(beta / max_fold_ *
-                                                                        flat_levels_));
+          const int flat =
+              std::min(flat_levels_ - 1, static_cast<int>(beta / max_fold_ * flat_levels_));
           return {p, level * flat_levels_ + flat};
         }
         break;  // a fold
