@@ -1,53 +1,150 @@
-// Micro-benchmarks of the mesher's hot stages on a synthetic sphere: grid build, ball query,
-// the whole in-memory mesher. Times are for comparison over commits, never asserted.
+// Micro-benchmarks of the mesher (src/pipeline, src/grow, src/cleanup) on synthetic clouds made
+// in-process: the whole mesh_tile on a 200k-point sphere and a 200k-point noisy terrain, growth
+// alone, and the non-manifold vertex pass on a grown (not yet cleaned) mesh. Times are for
+// comparison over commits on one machine, never asserted. Setup (clouds, grids, grown meshes)
+// is built once per process and kept out of the timed loops.
+//
+// TBB is limited to G2S_BENCH_THREADS threads (default 1, as bench/run.sh runs `g2s mesh
+// --threads 1`), so the numbers do not depend on how busy the other cores are; the mesher
+// benchmarks report wall-clock time (UseRealTime), so a parallel stage would still show up.
 #include <benchmark/benchmark.h>
+#include <tbb/global_control.h>
 
+#include <cstdint>
+#include <cstdlib>
+#include <map>
+#include <utility>
+#include <vector>
+
+#include "cleanup/cleanup.hpp"
 #include "g2s/mesher.hpp"
 #include "g2s/synth.hpp"
 #include "grid/hash_grid.hpp"
+#include "grow/grower.hpp"
 
 namespace {
 
-std::vector<float> sphere_points(std::uint64_t n) {
-  const g2s::PointCloud cloud = g2s::make_synthetic_cloud({g2s::SynthShape::sphere, n});
-  return {cloud.xyz.begin(), cloud.xyz.end()};
+std::size_t bench_threads() {
+  const char* text = std::getenv("G2S_BENCH_THREADS");
+  const long n = text ? std::strtol(text, nullptr, 10) : 1;
+  return n > 0 ? static_cast<std::size_t>(n) : 1;
 }
+// Process-wide for every *_bench.cpp: alive from static initialisation to exit.
+const tbb::global_control thread_limit(tbb::global_control::max_allowed_parallelism,
+                                       bench_threads());
 
-void BM_GridBuild(benchmark::State& state) {
-  const auto xyz = sphere_points(static_cast<std::uint64_t>(state.range(0)));
-  for (auto _ : state) {
-    g2s::HashGrid grid(xyz, {});
-    benchmark::DoNotOptimize(grid.size());
+constexpr std::uint64_t kMeshPoints = 200'000;
+constexpr double kTerrainNoise = 0.2;  // Gaussian sigma, in mean spacings
+
+// A synthetic cloud as the mesher sees it (3 floats each), cached per (shape, points, noise).
+const std::vector<float>& cloud_points(g2s::SynthShape shape, std::uint64_t n, double noise) {
+  static std::map<std::pair<int, std::uint64_t>, std::vector<float>> cache;
+  const std::pair<int, std::uint64_t> key{
+      static_cast<int>(shape) * 1000 + static_cast<int>(noise * 100), n};
+  auto it = cache.find(key);
+  if (it == cache.end()) {
+    g2s::SynthOptions options;
+    options.shape = shape;
+    options.points = n;
+    options.noise = noise;
+    const g2s::PointCloud cloud = g2s::make_synthetic_cloud(options);
+    it = cache.emplace(key, std::vector<float>(cloud.xyz.begin(), cloud.xyz.end())).first;
   }
-  state.SetItemsProcessed(state.iterations() * state.range(0));
+  return it->second;
 }
-BENCHMARK(BM_GridBuild)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
 
-void BM_BallQuery(benchmark::State& state) {
-  const auto xyz = sphere_points(1'000'000);
-  const g2s::HashGrid grid(xyz, {});
-  const double radius = 2.0 * grid.spacing();
-  std::uint32_t i = 0;
-  std::uint64_t found = 0;
-  for (auto _ : state) {
-    grid.for_each_in_ball(grid.position(i), radius, [&](std::uint32_t, double) { ++found; });
-    i = (i + 7919) % grid.size();
-  }
-  benchmark::DoNotOptimize(found);
-  state.SetItemsProcessed(state.iterations());
+const std::vector<float>& sphere() {
+  return cloud_points(g2s::SynthShape::sphere, kMeshPoints, 0);
 }
-BENCHMARK(BM_BallQuery);
+const std::vector<float>& terrain() {
+  return cloud_points(g2s::SynthShape::terrain, kMeshPoints, kTerrainNoise);
+}
 
-void BM_MeshSphere(benchmark::State& state) {
-  const auto xyz = sphere_points(static_cast<std::uint64_t>(state.range(0)));
+// The whole mesher (grid, growth, non-manifold pass, orientation, open edges) on one tile.
+// Counter "triangles/s" = output triangles per wall-clock second.
+void mesh_tile_bench(benchmark::State& state, const std::vector<float>& xyz) {
   std::uint64_t triangles = 0;
   for (auto _ : state) {
     const g2s::TileMesh mesh = g2s::mesh_tile(xyz, {}, {});
     triangles += mesh.triangles.size();
   }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(xyz.size() / 3));
+  state.counters["triangles"] =
+      benchmark::Counter(static_cast<double>(triangles), benchmark::Counter::kAvgIterations);
   state.counters["triangles/s"] =
       benchmark::Counter(static_cast<double>(triangles), benchmark::Counter::kIsRate);
 }
-BENCHMARK(BM_MeshSphere)->Arg(200'000)->Unit(benchmark::kMillisecond);
+
+void BM_MeshTile_Sphere200k(benchmark::State& state) {
+  mesh_tile_bench(state, sphere());
+}
+BENCHMARK(BM_MeshTile_Sphere200k)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_MeshTile_NoisyTerrain200k(benchmark::State& state) {
+  mesh_tile_bench(state, terrain());
+}
+BENCHMARK(BM_MeshTile_NoisyTerrain200k)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Growth alone (seeds, Gabriel walk, priority queue) on the 200k sphere's prebuilt grid.
+void BM_Grow_Sphere200k(benchmark::State& state) {
+  static const g2s::HashGrid grid(sphere(), {});
+  const g2s::MeshOptions options;
+  std::uint64_t triangles = 0;
+  for (auto _ : state) {
+    const g2s::GrowResult grown = g2s::grow_mesh(grid, options);
+    triangles += grown.triangles.size();
+  }
+  state.counters["triangles/s"] =
+      benchmark::Counter(static_cast<double>(triangles), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_Grow_Sphere200k)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The non-manifold vertex pass on the noisy terrain's grown triangles (before cleanup), as grown
+// (injected:0) and with a bow-tie added at every 100th vertex (injected:1: a triangle sharing
+// only that vertex with the mesh, so the vertex has two fans and the pass must remove one; the
+// grower may leave few or no non-manifold vertices, and this times the fixing path too). Each
+// iteration works on a fresh copy; copying is outside the timed region. Counters: triangles in,
+// vertices fixed and triangles removed per pass.
+void BM_NonManifold_NoisyTerrain200k(benchmark::State& state) {
+  struct Grown {
+    std::vector<g2s::Triangle> triangles;
+    std::size_t vertices = 0;
+  };
+  static const Grown grown = [] {
+    const g2s::HashGrid grid(terrain(), {});
+    return Grown{g2s::grow_mesh(grid, g2s::MeshOptions{}).triangles, grid.size()};
+  }();
+  static const Grown injected = [] {
+    Grown g = grown;
+    const auto n = static_cast<g2s::Index>(grown.vertices);
+    auto next = n;
+    for (g2s::Index v = 0; v < n; v += 100) {
+      g.triangles.push_back({v, next, next + 1});
+      next += 2;
+    }
+    g.vertices = next;
+    return g;
+  }();
+  const Grown& input = state.range(0) ? injected : grown;
+  g2s::NonManifoldReport report;
+  std::vector<g2s::Triangle> triangles;
+  for (auto _ : state) {
+    state.PauseTiming();
+    triangles = input.triangles;
+    state.ResumeTiming();
+    report = g2s::remove_non_manifold_vertices(triangles, input.vertices);
+    benchmark::DoNotOptimize(triangles.data());
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(input.triangles.size()));
+  state.counters["triangles_in"] = static_cast<double>(input.triangles.size());
+  state.counters["vertices_fixed"] = static_cast<double>(report.vertices_fixed);
+  state.counters["triangles_removed"] = static_cast<double>(report.triangles_removed);
+}
+BENCHMARK(BM_NonManifold_NoisyTerrain200k)
+    ->ArgName("injected")
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace

@@ -97,8 +97,8 @@ TEST(NonManifoldRemoval, TypeIExtraTriangleTouchingAClosedFanIsRemoved) {
   points.push_back({2, -0.5, 0.2});
   for (const bool extra_first : {false, true}) {
     const std::vector<Triangle> extra{{0, 6, 7}};
-    std::vector<Triangle> tris = extra_first ? concat({extra, kOctahedron})
-                                             : concat({kOctahedron, extra});
+    std::vector<Triangle> tris =
+        extra_first ? concat({extra, kOctahedron}) : concat({kOctahedron, extra});
     const g2s::MeshStats before = stats_of(points, tris);
     ASSERT_EQ(before.non_manifold_vertices_type1, 1u);
     const auto report = g2s::remove_non_manifold_vertices(tris, points.size());
@@ -132,8 +132,8 @@ TEST(NonManifoldRemoval, TypeIITheSmallerOfTwoOpenFansIsRemoved) {
   const std::vector<Triangle> a1{{0, 1, 2}}, a2{{0, 2, 3}};
   const std::vector<Triangle> b1{{0, 4, 5}}, b2{{0, 5, 6}}, b3{{0, 6, 7}};
   for (const bool small_first : {true, false}) {
-    std::vector<Triangle> tris = small_first ? concat({a1, b1, a2, b2, b3})
-                                             : concat({b1, b2, a1, b3, a2});
+    std::vector<Triangle> tris =
+        small_first ? concat({a1, b1, a2, b2, b3}) : concat({b1, b2, a1, b3, a2});
     const g2s::MeshStats before = stats_of(points, tris);
     ASSERT_EQ(before.non_manifold_vertices_type2, 1u);
     ASSERT_EQ(before.non_manifold_vertices, 1u);
@@ -176,8 +176,8 @@ Torus torus(int nu, int nv) {
   for (int j = 0; j < nv; ++j) {
     for (int i = 0; i < nu; ++i) {
       const double u = 2 * pi * i / nu, v = 2 * pi * j / nv;
-      t.points.push_back({(3 + std::cos(v)) * std::cos(u), (3 + std::cos(v)) * std::sin(u),
-                          std::sin(v)});
+      t.points.push_back(
+          {(3 + std::cos(v)) * std::cos(u), (3 + std::cos(v)) * std::sin(u), std::sin(v)});
     }
   }
   auto id = [&](int i, int j) { return static_cast<Index>((j % nv) * nu + (i % nu)); };

@@ -110,10 +110,8 @@ TEST(Circumball, NearlyCollinearCapIsRejectedWhicheverCornerComesFirst) {
 
 // A needle: two corners very close, the third far; smallest angle ~0.0006 degrees, ten times below
 // the ~0.006 degree sliver limit vec3.hpp documents.
-// FINDING (src/common/vec3.hpp, circumball): the sliver test w2 > 1e-8 * |u|^2 * |v|^2 measures
-// the angle at the FIRST corner only, so the needle is rejected when its tiny angle is at `a` and
-// accepted when it is at `b` or `c`: the answer depends on the corner order, and the documented
-// "smallest angle below ~0.006 degrees" rule does not hold. Kept failing for the lead to decide.
+// Regression: the sliver test once measured the angle at the first corner only, so the needle's
+// rejection depended on the corner order. It now uses the angle between the two longest edges.
 TEST(Circumball, NeedleSliverIsRejectedWhicheverCornerHoldsTheTinyAngle) {
   const Vec3 p[3] = {{0, 0, 0}, {1e-5, 0, 0}, {0, 1, 0}};  // tiny angle at p[2]
   Ball ball;

@@ -1,18 +1,23 @@
 // Tests of the hash grid (src/grid/hash_grid.hpp, ALGORITHM.md §2): ball queries and nearest
 // neighbours against brute force over awkward clouds, duplicate merging, ids, independence from
 // the input order and the spacing estimate.
-#include "grid/hash_grid.hpp"
-
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <numeric>
 #include <random>
 #include <string>
 #include <vector>
+
+#include "grid/hash_grid.hpp"
 
 namespace {
 
@@ -59,10 +64,11 @@ Cloud flat_plane(std::mt19937_64& rng, int n) {
   return c;
 }
 
-// 4000 points in a 0.01-wide cube inside a sparse cloud 10 wide: 1e8:1 density.
-Cloud uneven_density(std::mt19937_64& rng, int n) {
+// 80% of the points in a cube `dense` wide inside 20% scattered over a 10-wide cube: with dense =
+// 1 the density ratio is 1000:1, with 0.01 it is 1e9:1.
+Cloud uneven_density(std::mt19937_64& rng, int n, double dense_size = 1.0) {
   Cloud c{"uneven density", {}};
-  std::uniform_real_distribution<double> dense(0.0, 0.01), sparse(-5.0, 5.0);
+  std::uniform_real_distribution<double> dense(0.0, dense_size), sparse(-5.0, 5.0);
   for (int i = 0; i < n; ++i) {
     if (i % 5 == 0) {
       push(c, sparse(rng), sparse(rng), sparse(rng));
@@ -73,11 +79,12 @@ Cloud uneven_density(std::mt19937_64& rng, int n) {
   return c;
 }
 
-Cloud far_outlier(std::mt19937_64& rng, int n) {
-  Cloud c{"unit box plus one far outlier", {}};
+// A unit cube of points and one outlier at `far` * (1, -2, 3).
+Cloud far_outlier(std::mt19937_64& rng, int n, double far) {
+  Cloud c{"unit box plus one outlier", {}};
   std::uniform_real_distribution<double> u(0.0, 1.0);
   for (int i = 0; i + 1 < n; ++i) push(c, u(rng), u(rng), u(rng));
-  push(c, 1e4, -2e4, 3e4);
+  push(c, far, -2 * far, 3 * far);
   return c;
 }
 
@@ -121,8 +128,8 @@ void expect_ball_matches(const HashGrid& grid, const Vec3& c, double radius,
   EXPECT_EQ(std::unique(got.begin(), got.end()), got.end()) << what << ": a point visited twice";
   ASSERT_EQ(visited, got.size()) << what;
   const std::vector<std::uint32_t> want = brute_ball(grid, c, radius);
-  ASSERT_EQ(got, want) << what << " centre (" << c.x << ", " << c.y << ", " << c.z
-                       << ") radius " << radius;
+  ASSERT_EQ(got, want) << what << " centre (" << c.x << ", " << c.y << ", " << c.z << ") radius "
+                       << radius;
 }
 
 struct Box {
@@ -148,7 +155,7 @@ std::vector<Cloud> awkward_clouds() {
   clouds.push_back(sphere_surface(rng, 4000));
   clouds.push_back(flat_plane(rng, 4000));
   clouds.push_back(uneven_density(rng, 5000));
-  clouds.push_back(far_outlier(rng, 3000));
+  clouds.push_back(far_outlier(rng, 3000, 5.0));  // ~470 spacings out
   clouds.push_back(integer_lattice());
   return clouds;
 }
@@ -161,8 +168,7 @@ TEST(HashGrid, BallQueryFindsExactlyThePointsBruteForceFinds) {
     const double extent = box.extent();
     std::mt19937_64 rng(7);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
-    int queries = 0;
-    for (int q = 0; q < 300; ++q) {
+    for (int q = 0; q < 200; ++q) {
       // Centres in the bounding box grown by half its size on every side: some lie outside.
       Vec3 c;
       double* cc[3] = {&c.x, &c.y, &c.z};
@@ -170,28 +176,46 @@ TEST(HashGrid, BallQueryFindsExactlyThePointsBruteForceFinds) {
         const double span = box.hi[a] - box.lo[a];
         *cc[a] = box.lo[a] - 0.5 * span + 2.0 * span * unit(rng);
       }
-      // Radii from tiny (a few spacings) to larger than the whole cloud, and zero.
+      // Radii from zero and a few spacings to larger than the whole cloud.
       double radius = 0;
-      switch (q % 5) {
-        case 0: radius = 0; break;
-        case 1: radius = grid.spacing() * 5 * unit(rng); break;
-        case 2: radius = extent * 0.2 * unit(rng); break;
-        case 3: radius = extent * unit(rng); break;
-        default: radius = extent * (2 + unit(rng)); break;
+      switch (q % 10) {
+        case 0:
+          radius = 0;
+          break;
+        case 1:
+        case 2:
+        case 3:
+          radius = grid.spacing() * 5 * unit(rng);
+          break;
+        case 4:
+        case 5:
+          radius = extent * 0.1 * unit(rng);
+          break;
+        case 6:
+        case 7:
+          radius = extent * 0.4 * unit(rng);
+          break;
+        case 8:
+          radius = extent * unit(rng);
+          break;
+        default:
+          radius = extent * (2 + unit(rng));
+          break;
       }
       expect_ball_matches(grid, c, radius, cloud.name);
-      ++queries;
-      // Centred on a sample: radius 0 finds exactly it; radius = the distance to another sample
-      // puts that sample exactly on the sphere.
+      // Centred on a sample: radius 0 finds exactly it; radius = the distance to one of its 20
+      // nearest neighbours puts that neighbour exactly on the sphere.
       const auto i = static_cast<std::uint32_t>(rng() % grid.size());
-      const auto j = static_cast<std::uint32_t>(rng() % grid.size());
       const Vec3 pi = grid.position(i);
+      std::vector<double> d2;
+      for (std::uint32_t j = 0; j < grid.size(); ++j) d2.push_back(dist2(grid.point(j), pi));
+      const auto k = static_cast<std::ptrdiff_t>(1 + rng() % 20);
+      std::nth_element(d2.begin(), d2.begin() + k, d2.end());
       expect_ball_matches(grid, pi, 0.0, cloud.name + " (radius 0 on a sample)");
-      expect_ball_matches(grid, pi, std::sqrt(dist2(grid.point(j), pi)),
+      expect_ball_matches(grid, pi, std::sqrt(d2[static_cast<std::size_t>(k)]),
                           cloud.name + " (sample on the sphere)");
       if (HasFatalFailure()) return;
     }
-    EXPECT_EQ(queries, 300);
   }
 }
 
@@ -201,7 +225,8 @@ TEST(HashGrid, BallOfRadiusZeroOnASampleFindsOnlyThatSample) {
   const HashGrid grid(cloud.xyz, {});
   for (std::uint32_t i = 0; i < grid.size(); i += 37) {
     std::vector<std::uint32_t> got;
-    grid.for_each_in_ball(grid.position(i), 0.0, [&](std::uint32_t j, double) { got.push_back(j); });
+    grid.for_each_in_ball(grid.position(i), 0.0,
+                          [&](std::uint32_t j, double) { got.push_back(j); });
     EXPECT_EQ(got, std::vector<std::uint32_t>{i});
   }
 }
@@ -396,7 +421,8 @@ TEST(HashGrid, ShuffledInputGivesTheSamePointOrderAndIds) {
   std::iota(perm.begin(), perm.end(), 0u);
   std::shuffle(perm.begin(), perm.end(), rng2);
   std::vector<float> xyz;
-  for (Index k : perm) xyz.insert(xyz.end(), cloud.xyz.begin() + 3 * k, cloud.xyz.begin() + 3 * k + 3);
+  for (Index k : perm)
+    xyz.insert(xyz.end(), cloud.xyz.begin() + 3 * k, cloud.xyz.begin() + 3 * k + 3);
   expect_same_grid(plain, HashGrid(xyz, perm));
 }
 
@@ -430,6 +456,101 @@ TEST(HashGrid, SpacingIsWithinTenPercentOfTheMedianNearestNeighbourDistance) {
     const double median = nn[nn.size() / 2];
     EXPECT_NEAR(grid.spacing(), median, 0.1 * median) << cloud.name;
   }
+}
+
+// Runs work() in a forked child and returns its failure message, "" on success. A child still
+// running after `seconds` is killed and reported, so a hang fails the test instead of stalling
+// the suite.
+std::string run_with_deadline(double seconds, const std::function<std::string()>& work) {
+  int fds[2];
+  if (pipe(fds) != 0) return "pipe() failed";
+  const pid_t pid = fork();
+  if (pid < 0) return "fork() failed";
+  if (pid == 0) {
+    close(fds[0]);
+    std::string message;
+    try {
+      message = work();
+    } catch (const std::exception& e) {
+      message = std::string("exception: ") + e.what();
+    }
+    message = message.substr(0, 4000);
+    if (!message.empty() && write(fds[1], message.data(), message.size()) < 0) _exit(3);
+    _exit(message.empty() ? 0 : 1);
+  }
+  close(fds[1]);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  int status = 0;
+  bool timed_out = false;
+  while (waitpid(pid, &status, WNOHANG) != pid) {
+    if (std::chrono::steady_clock::now() > deadline) {
+      kill(pid, SIGKILL);
+      waitpid(pid, &status, 0);
+      timed_out = true;
+      break;
+    }
+    usleep(2000);
+  }
+  std::string message;
+  char buffer[4096];
+  for (ssize_t got; (got = read(fds[0], buffer, sizeof buffer)) > 0;) {
+    message.append(buffer, static_cast<std::size_t>(got));
+  }
+  close(fds[0]);
+  if (timed_out) return "did not finish within " + std::to_string(seconds) + " s";
+  if (WIFSIGNALED(status)) return "crashed with signal " + std::to_string(WTERMSIG(status));
+  if (WEXITSTATUS(status) != 0 && message.empty()) return "child failed";
+  return message;
+}
+
+// Builds the grid, then checks ball queries (radius 0, a few spacings, larger than the cloud) and
+// the nearest neighbour of every 50th point against brute force. "" when all agree.
+std::string check_grid_against_brute_force(const Cloud& cloud) {
+  const HashGrid grid(cloud.xyz, {});
+  if (grid.size() != cloud.size()) return "points lost";
+  const Box box = bounds(cloud);
+  const double extent = box.extent();
+  std::mt19937_64 rng(3);
+  for (int q = 0; q < 30; ++q) {
+    const auto i = static_cast<std::uint32_t>(rng() % grid.size());
+    const double radius = q % 3 == 0 ? 0.0 : q % 3 == 1 ? 4 * grid.spacing() : 2 * extent;
+    std::vector<std::uint32_t> got;
+    grid.for_each_in_ball(grid.position(i), radius,
+                          [&](std::uint32_t j, double) { got.push_back(j); });
+    std::sort(got.begin(), got.end());
+    if (got != brute_ball(grid, grid.position(i), radius)) {
+      return "ball query differs at point " + std::to_string(i) + " radius " +
+             std::to_string(radius);
+    }
+  }
+  const std::vector<std::uint8_t> all(grid.size(), 1);
+  for (std::uint32_t i = 0; i < grid.size(); i += 50) {
+    const std::uint32_t got = grid.nearest(i, 3 * extent, [](std::uint32_t) { return true; });
+    if (got != brute_nearest(grid, i, 3 * extent, all)) {
+      return "nearest differs at point " + std::to_string(i);
+    }
+  }
+  return "";
+}
+
+// Regression: the spacing estimate's nearest() once searched an isolated point's neighbourhood
+// cell by cell, cost (distance / cell)^3: an outlier 1e4 away took years. Now the estimate skips
+// points with no neighbour within 64 cells, and a ball spanning more cells than there are points
+// scans the points instead. Expected: well under a second.
+TEST(HashGrid, CloudWithAFarOutlierIsBuiltAndQueriedQuickly) {
+  std::mt19937_64 rng(8);
+  const Cloud cloud = far_outlier(rng, 3000, 1e4);
+  const std::string failure =
+      run_with_deadline(3.0, [&] { return check_grid_against_brute_force(cloud); });
+  EXPECT_EQ(failure, "") << "3000 points in [0,1]^3 + one at (1e4, -2e4, 3e4)";
+}
+
+TEST(HashGrid, CloudOfVeryUnevenDensityIsBuiltAndQueriedQuickly) {
+  std::mt19937_64 rng(8);
+  const Cloud cloud = uneven_density(rng, 5000, 0.01);
+  const std::string failure =
+      run_with_deadline(3.0, [&] { return check_grid_against_brute_force(cloud); });
+  EXPECT_EQ(failure, "") << "4000 points in [0,0.01]^3 + 1000 in [-5,5]^3";
 }
 
 }  // namespace

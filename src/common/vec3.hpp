@@ -2,6 +2,7 @@
 // for predicates (circumcentres of thin triangles need the precision).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
 namespace g2s {
@@ -51,9 +52,13 @@ inline bool circumball(const Vec3& a, const Vec3& b, const Vec3& c, Ball& out) {
   const double w2 = norm2(w);
   const double uu = norm2(u);
   const double vv = norm2(v);
-  // Reject slivers (smallest angle below ~0.006 degrees): their circumcentre is numerically
-  // meaningless and, written out, they may become exactly collinear.
-  if (!(w2 > 1e-8 * uu * vv)) return false;
+  const double cc = norm2(c - b);
+  // Reject slivers: the smallest angle lies between the two longest edges, and its squared sine
+  // is |w|^2 over the product of their squared lengths. Below ~0.006 degrees the circumcentre is
+  // numerically meaningless and, written out, the triangle may become exactly collinear.
+  const double longest = std::max({uu, vv, cc});
+  const double second = uu + vv + cc - longest - std::min({uu, vv, cc});
+  if (!(w2 > 1e-8 * longest * second)) return false;
   const Vec3 offset = (cross(w, u) * vv + cross(v, w) * uu) * (0.5 / w2);
   out.centre = a + offset;
   out.radius2 = norm2(offset);

@@ -3,6 +3,7 @@
 #include "grid/hash_grid.hpp"
 
 #include <bit>
+#include <cstring>
 #include <numeric>
 
 namespace g2s {
@@ -72,16 +73,12 @@ HashGrid::HashGrid(std::span<const float> xyz, std::span<const Index> ids) {
 
   build(xyz, ids, std::max(cell, min_cell));
   spacing_ = estimate_spacing();
-  // Aim for a cell edge of about three spacings: a front search ball (radius about one edge,
+  // Rebuild with a cell edge of about three spacings: a front search ball (radius about one edge,
   // which on noisy scans is often twice the nearest-neighbour distance) then spans about two
-  // cells per axis, and a cell holds about ten surface points, scanned sequentially.
-  if (spacing_ > 0) {
-    const double wanted = std::max(3.0 * spacing_, min_cell);
-    if (wanted < 0.7 * cell_ || wanted > 1.4 * cell_) {
-      build(xyz, ids, wanted);
-      spacing_ = estimate_spacing();
-    }
-  }
+  // cells per axis, and a cell holds about ten surface points, scanned sequentially. Always
+  // rebuilt, so the cell size, and with it the point order and the mesh, depend only on the
+  // distinct points, not on duplicates or on the first guess.
+  if (spacing_ > 0) build(xyz, ids, std::max(3.0 * spacing_, min_cell));
 }
 
 void HashGrid::build(std::span<const float> xyz, std::span<const Index> ids, double cell) {
@@ -163,13 +160,21 @@ void HashGrid::build(std::span<const float> xyz, std::span<const Index> ids, dou
 double HashGrid::estimate_spacing() const {
   const std::uint32_t n = size();
   if (n < 2) return 0.0;
-  const std::uint32_t samples = std::min<std::uint32_t>(n, 4096);
-  const double max_radius =
-      cell_ * static_cast<double>(std::max({dims_[0], dims_[1], dims_[2]})) * 2.0;
+  // Samples are chosen by a hash of their coordinates, not their place in the grid order, so
+  // the estimate does not depend on the first cell size. A point with no neighbour within 64
+  // cells is an outlier and is left out rather than searched for across empty space.
+  const std::uint64_t threshold = n <= 4096 ? ~0ull : (~0ull / n) * 4096;
+  const double max_radius = 64 * cell_;
   std::vector<double> d;
-  d.reserve(samples);
-  for (std::uint32_t s = 0; s < samples; ++s) {
-    const std::uint32_t i = static_cast<std::uint32_t>(static_cast<std::uint64_t>(s) * n / samples);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const Vec3f& p = points_[i];
+    std::uint32_t bits[3];
+    std::memcpy(bits, &p, sizeof bits);
+    std::uint64_t h = (std::uint64_t{bits[0]} << 32 | bits[1]) ^ (std::uint64_t{bits[2]} << 16);
+    h ^= h >> 31;
+    h *= 0x9E3779B97F4A7C15ull;
+    h ^= h >> 29;
+    if (h > threshold) continue;
     const std::uint32_t j = nearest(i, max_radius, [](std::uint32_t) { return true; });
     if (j != kNoIndex) d.push_back(std::sqrt(norm2(position(i) - position(j))));
   }

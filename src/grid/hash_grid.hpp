@@ -98,6 +98,24 @@ void HashGrid::for_each_in_ball(const Vec3& centre, double radius, Visit&& visit
   };
   const std::int64_t z0 = std::max<std::int64_t>(cell_coord(centre.z - radius, 2), 0);
   const std::int64_t z1 = std::min<std::int64_t>(cell_coord(centre.z + radius, 2), dims_[2] - 1);
+  // A ball spanning more cells than there are points (far outliers, very uneven density) is
+  // cheaper to answer by scanning the points than by probing mostly empty cells.
+  double box_cells = static_cast<double>(z1 - z0 + 1);
+  for (int a = 0; a < 2; ++a) {
+    const double c = a == 0 ? centre.x : centre.y;
+    box_cells *=
+        static_cast<double>(std::min<std::int64_t>(cell_coord(c + radius, a), dims_[a] - 1) -
+                            std::max<std::int64_t>(cell_coord(c - radius, a), 0) + 1);
+  }
+  if (box_cells > static_cast<double>(points_.size())) {
+    for (std::uint32_t i = 0; i < points_.size(); ++i) {
+      const Vec3f& p = points_[i];
+      const double dx = p.x - centre.x, dy = p.y - centre.y, dz = p.z - centre.z;
+      const double d2 = dx * dx + dy * dy + dz * dz;
+      if (d2 <= r2) visit(i, d2);
+    }
+    return;
+  }
   for (std::int64_t z = z0; z <= z1; ++z) {
     const double gz = gap(z, centre.z, 2);
     const double rz2 = r2 - gz * gz;
