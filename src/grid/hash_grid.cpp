@@ -143,18 +143,18 @@ void HashGrid::build(std::span<const float> xyz, std::span<const Index> ids, dou
   }
   cell_start_.push_back(static_cast<std::uint32_t>(points_.size()));
 
-  std::size_t slots = 16;
+  std::size_t slots = 128;  // at least two 64-slot regions, so slot_shift_ stays below 64
   while (slots < 2 * cell_codes.size()) slots *= 2;
   slot_mask_ = slots - 1;
-  slot_shift_ = 64 - std::countr_zero(slots);
-  slot_code_.assign(slots, kEmpty);
-  slot_cell_.assign(slots, kNoIndex);
-  for (std::uint32_t c = 0; c < cell_codes.size(); ++c) {
-    std::uint64_t slot = (cell_codes[c] * 0x9E3779B97F4A7C15ull) >> slot_shift_;
-    while (slot_code_[slot] != kEmpty) slot = (slot + 1) & slot_mask_;
-    slot_code_[slot] = cell_codes[c];
-    slot_cell_[slot] = c;
+  slot_shift_ = 64 - std::countr_zero(slots / 64);
+  slots_.assign(slots, Slot{kEmpty, 0, 0});
+  for (std::size_t c = 0; c < cell_codes.size(); ++c) {
+    std::uint64_t slot = slot_of(cell_codes[c]);
+    while (slots_[slot].code != kEmpty) slot = (slot + 1) & slot_mask_;
+    slots_[slot] = {cell_codes[c], cell_start_[c], cell_start_[c + 1]};
   }
+  cell_start_.clear();
+  cell_start_.shrink_to_fit();
 }
 
 double HashGrid::estimate_spacing() const {

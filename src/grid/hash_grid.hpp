@@ -46,15 +46,25 @@ class HashGrid {
   std::int64_t cell_coord(double v, int axis) const {
     return static_cast<std::int64_t>(std::floor((v - origin_[axis]) * inv_cell_));
   }
-  std::uint32_t find_cell(std::uint64_t code) const;
+  // A hash slot: a non-empty cell's Morton code and its range of points_. One 16-byte slot per
+  // probe, so finding a cell's points costs one cache line.
+  struct Slot {
+    std::uint64_t code;
+    std::uint32_t begin, end;
+  };
+  // The 4x4x4 block of cells around a cell (the low 6 Morton bits) shares one 64-slot region:
+  // a query's neighbouring cells are found in the same few cache lines.
+  std::uint64_t slot_of(std::uint64_t code) const {
+    return (((code >> 6) * 0x9E3779B97F4A7C15ull) >> slot_shift_ << 6 | (code & 63)) & slot_mask_;
+  }
+  const Slot* find_cell(std::uint64_t code) const;
 
   std::vector<Vec3f> points_;
   std::vector<Index> ids_;
-  std::vector<std::uint32_t> cell_start_;  // cells + 1 offsets into points_
-  std::vector<std::uint64_t> slot_code_;   // hash slots: Morton code of the cell, or kEmpty
-  std::vector<std::uint32_t> slot_cell_;   // hash slots: cell index
+  std::vector<std::uint32_t> cell_start_;  // while building: cells + 1 offsets into points_
+  std::vector<Slot> slots_;                // open addressing, linear probing, load <= 1/2
   std::uint64_t slot_mask_ = 0;
-  int slot_shift_ = 60;  // 64 - log2(slots): the top bits of the product are the best mixed
+  int slot_shift_ = 64;  // 64 - log2(slots / 64): the top bits of the product are the best mixed
   double origin_[3] = {0, 0, 0};
   double cell_ = 1.0;
   double inv_cell_ = 1.0;
@@ -77,13 +87,11 @@ inline std::uint64_t morton3(std::uint64_t x, std::uint64_t y, std::uint64_t z) 
   return spread(x) | spread(y) << 1 | spread(z) << 2;
 }
 
-inline std::uint32_t HashGrid::find_cell(std::uint64_t code) const {
-  std::uint64_t slot = (code * 0x9E3779B97F4A7C15ull) >> slot_shift_;
-  for (;;) {
-    const std::uint64_t c = slot_code_[slot];
-    if (c == code) return slot_cell_[slot];
-    if (c == ~0ull) return kNoIndex;
-    slot = (slot + 1) & slot_mask_;
+inline const HashGrid::Slot* HashGrid::find_cell(std::uint64_t code) const {
+  for (std::uint64_t slot = slot_of(code);; slot = (slot + 1) & slot_mask_) {
+    const Slot& s = slots_[slot];
+    if (s.code == code) return &s;
+    if (s.code == ~0ull) return nullptr;
   }
 }
 
@@ -131,11 +139,11 @@ void HashGrid::for_each_in_ball(const Vec3& centre, double radius, Visit&& visit
       const std::int64_t x0 = std::max<std::int64_t>(cell_coord(centre.x - ry, 0), 0);
       const std::int64_t x1 = std::min<std::int64_t>(cell_coord(centre.x + ry, 0), dims_[0] - 1);
       for (std::int64_t x = x0; x <= x1; ++x) {
-        const std::uint32_t cell =
+        const Slot* cell =
             find_cell(morton3(static_cast<std::uint64_t>(x), static_cast<std::uint64_t>(y),
                               static_cast<std::uint64_t>(z)));
-        if (cell == kNoIndex) continue;
-        for (std::uint32_t i = cell_start_[cell], end = cell_start_[cell + 1]; i < end; ++i) {
+        if (!cell) continue;
+        for (std::uint32_t i = cell->begin, end = cell->end; i < end; ++i) {
           const Vec3f& p = points_[i];
           const double dx = p.x - centre.x, dy = p.y - centre.y, dz = p.z - centre.z;
           const double d2 = dx * dx + dy * dy + dz * dz;
