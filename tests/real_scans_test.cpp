@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <ostream>
 #include <string>
 
 #include "g2s/io.hpp"
@@ -29,6 +30,9 @@ struct Baseline {
   std::uint64_t max_boundary_edges;
   std::uint64_t max_holes;
 };
+
+// So that test listings name the cloud rather than dump the struct's bytes.
+void PrintTo(const Baseline& b, std::ostream* os) { *os << b.name; }
 
 class RealScan : public ::testing::TestWithParam<Baseline> {};
 
