@@ -5,6 +5,7 @@
 // deleted. Deleting can split a fan at the deleted triangles' other corners, so those go back on
 // a worklist. Each deletion is final, so the total work is linear in the mesh size.
 #include <algorithm>
+#include <functional>
 #include <numeric>
 
 #include "cleanup/cleanup.hpp"
@@ -21,7 +22,16 @@ std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t x) {
 
 NonManifoldReport remove_non_manifold_vertices(std::vector<Triangle>& triangles,
                                                std::size_t vertex_count) {
+  std::vector<Index> all(vertex_count);
+  std::iota(all.begin(), all.end(), Index{0});
+  return remove_non_manifold_vertices_at(triangles, vertex_count, all);
+}
+
+NonManifoldReport remove_non_manifold_vertices_at(std::vector<Triangle>& triangles,
+                                                  std::size_t vertex_count,
+                                                  std::span<const Index> suspects) {
   NonManifoldReport report;
+  if (suspects.empty()) return report;
   const std::size_t nt = triangles.size();
   // CSR: vertex -> incident triangles.
   std::vector<std::uint32_t> start(vertex_count + 1, 0);
@@ -37,10 +47,12 @@ NonManifoldReport remove_non_manifold_vertices(std::vector<Triangle>& triangles,
     }
   }
   std::vector<std::uint8_t> dead(nt, 0);
-  std::vector<std::uint8_t> queued(vertex_count, 1);
-  std::vector<Index> work(vertex_count);
-  std::iota(work.begin(), work.end(), Index{0});
-  std::reverse(work.begin(), work.end());  // pop from the back: vertex 0 first
+  // Suspects are examined in index order whatever order they arose in.
+  std::vector<std::uint8_t> queued(vertex_count, 0);
+  std::vector<Index> work(suspects.begin(), suspects.end());
+  std::sort(work.begin(), work.end(), std::greater<Index>());  // popped from the back
+  work.erase(std::unique(work.begin(), work.end()), work.end());
+  for (Index v : work) queued[v] = 1;
 
   // Scratch for one star.
   std::vector<std::uint32_t> tris, parent, size;

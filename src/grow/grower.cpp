@@ -75,6 +75,7 @@ class Grower {
       drain();
     }
     result.triangles = std::move(triangles_);
+    result.second_fans = std::move(second_fans_);
     return result;
   }
 
@@ -248,6 +249,9 @@ class Grower {
     for (std::uint32_t t : {on_ap, on_pb}) {
       if (t != EdgeMap::kMissing && dot(n_new, normal_of(t)) < cos_max_fold_) return false;
     }
+    if (used_[p] && on_ap == EdgeMap::kMissing && on_pb == EdgeMap::kMissing) {
+      second_fans_.push_back(p);
+    }
     add_triangle(e.b, e.a, p);
     return true;
   }
@@ -311,6 +315,7 @@ class Grower {
   const int levels_;
   const int flat_levels_;
   std::vector<Triangle> triangles_;
+  std::vector<Index> second_fans_;
   EdgeMap edges_;
   std::vector<std::uint8_t> used_;
   std::vector<std::uint8_t> seed_tried_;

@@ -12,6 +12,9 @@ namespace g2s {
 struct GrowResult {
   std::vector<Triangle> triangles;  // in grid indices; consistently oriented per component
   std::uint64_t seeds = 0;
+  // Points where a triangle started a second fan (fronts meeting at a point): the only places a
+  // non-manifold vertex can be, in the order they arose.
+  std::vector<Index> second_fans;
 };
 
 // Grows triangles from seed triangles until no unused point can seed a new component.

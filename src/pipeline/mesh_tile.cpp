@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "cleanup/cleanup.hpp"
-#include "common/edge_map.hpp"
 #include "g2s/error.hpp"
 #include "g2s/mesher.hpp"
 #include "grid/hash_grid.hpp"
@@ -15,23 +14,6 @@ namespace {
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-// Edges used by exactly one triangle, as that triangle traverses them.
-std::vector<std::array<Index, 2>> open_edges_of(const std::vector<Triangle>& triangles,
-                                                std::size_t vertex_count) {
-  EdgeMap edges(vertex_count);
-  for (std::uint32_t t = 0; t < triangles.size(); ++t) {
-    for (int k = 0; k < 3; ++k) edges.add(triangles[t][k], triangles[t][(k + 1) % 3], t);
-  }
-  std::vector<std::array<Index, 2>> open;
-  for (std::uint32_t t = 0; t < triangles.size(); ++t) {
-    for (int k = 0; k < 3; ++k) {
-      const Index u = triangles[t][k], v = triangles[t][(k + 1) % 3];
-      if (!(edges.find(u, v) & EdgeMap::kClosed)) open.push_back({u, v});
-    }
-  }
-  return open;
 }
 
 }  // namespace
@@ -62,11 +44,14 @@ TileMesh mesh_tile(std::span<const float> xyz, std::span<const Index> ids,
 
   t0 = std::chrono::steady_clock::now();
   std::vector<Triangle>& triangles = grown.triangles;
-  const NonManifoldReport nm = remove_non_manifold_vertices(triangles, grid.size());
+  const NonManifoldReport nm =
+      remove_non_manifold_vertices_at(triangles, grid.size(), grown.second_fans);
   out.report.triangles_removed = nm.triangles_removed;
   out.report.non_manifold_vertices_fixed = nm.vertices_fixed;
-  if (options.orient) out.report.components_flipped = orient_components(triangles, grid.points());
-  out.open_edges = open_edges_of(triangles, grid.size());
+  out.open_edges = open_edges(triangles, grid.size());
+  if (options.orient) {
+    out.report.components_flipped = orient_components(triangles, grid.points(), out.open_edges);
+  }
   for (Triangle& t : triangles) {
     for (Index& v : t) v = grid.id(v);
   }
