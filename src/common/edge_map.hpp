@@ -21,8 +21,9 @@ class EdgeMap {
 
   void reset(std::size_t vertex_count) {
     std::size_t slots = 64;
-    // A triangulated surface has about 3 edges per vertex; keep the load factor under 5/8.
-    while (slots * 5 < vertex_count * 3 * 8) slots *= 2;
+    // 8 slots per vertex: a triangulated surface has about 3 edges per vertex (counted at the
+    // smaller one), so the load stays near 3/8 and probe runs short.
+    while (slots < vertex_count * 8) slots *= 2;
     keys_.assign(slots, kEmpty);
     values_.assign(slots, kMissing);
     mask_ = slots - 1;
@@ -61,8 +62,10 @@ class EdgeMap {
   static std::uint64_t make_key(Index u, Index v) {
     return u < v ? std::uint64_t{u} << 32 | v : std::uint64_t{v} << 32 | u;
   }
+  // An edge's probe starts in its smaller vertex's own 8 slots: points are in Morton order, so
+  // the edges of nearby points share cache lines and a growing front touches memory locally.
   std::uint64_t slot_of(std::uint64_t key) const {
-    return (key * 0x9E3779B97F4A7C15ull) >> 17 & mask_;
+    return ((key >> 32) * 8 + (key & 7)) & mask_;
   }
   void grow() {
     std::vector<std::uint64_t> keys(keys_.size() * 2, kEmpty);
