@@ -25,8 +25,11 @@
 
 #include "g2s/stats.hpp"
 #include "g2s/synth.hpp"
+#include "run_with_deadline.hpp"
 
 namespace {
+
+using g2s::test_support::run_with_deadline;
 
 using g2s::Index;
 using g2s::IndexedMesh;
@@ -388,51 +391,6 @@ TEST(Mesher, SphereWithOnePercentOutliersIsStillMeshedAsOneSurface) {
     EXPECT_GE(s.triangles, 9'800u) << name;
     EXPECT_LE(mesh.report.triangles_grown, 11'000u) << name << ": growth ran away";
   }
-}
-
-// Runs work() in a forked child and returns its failure message, "" on success. A child still
-// running after `seconds` is killed and reported, so a hang fails the test instead of stalling
-// the suite.
-std::string run_with_deadline(double seconds, const std::function<std::string()>& work) {
-  int fds[2];
-  if (pipe(fds) != 0) return "pipe() failed";
-  const pid_t pid = fork();
-  if (pid < 0) return "fork() failed";
-  if (pid == 0) {
-    close(fds[0]);
-    std::string message;
-    try {
-      message = work();
-    } catch (const std::exception& e) {
-      message = std::string("exception: ") + e.what();
-    }
-    message = message.substr(0, 4000);
-    if (!message.empty() && write(fds[1], message.data(), message.size()) < 0) _exit(3);
-    _exit(message.empty() ? 0 : 1);
-  }
-  close(fds[1]);
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  int status = 0;
-  bool timed_out = false;
-  while (waitpid(pid, &status, WNOHANG) != pid) {
-    if (std::chrono::steady_clock::now() > deadline) {
-      kill(pid, SIGKILL);
-      waitpid(pid, &status, 0);
-      timed_out = true;
-      break;
-    }
-    usleep(2000);
-  }
-  std::string message;
-  char buffer[4096];
-  for (ssize_t got; (got = read(fds[0], buffer, sizeof buffer)) > 0;) {
-    message.append(buffer, static_cast<std::size_t>(got));
-  }
-  close(fds[0]);
-  if (timed_out) return "did not finish within " + std::to_string(seconds) + " s";
-  if (WIFSIGNALED(status)) return "crashed with signal " + std::to_string(WTERMSIG(status));
-  if (WEXITSTATUS(status) != 0 && message.empty()) return "child failed";
-  return message;
 }
 
 // Regression: a single far outlier once hung the spacing estimate (see grid_test.cpp,
