@@ -5,6 +5,7 @@
 
 #include "commands.hpp"
 #include "g2s/error.hpp"
+#include "g2s/io.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -12,6 +13,7 @@ int main(int argc, char** argv) {
       "Exit codes: 0 success; 1 internal error; 2 bad command line; 3 bad input (missing,\n"
       "unreadable, malformed, no usable points); 4 output could not be written (missing or\n"
       "read-only folder, disk full); 130 interrupted."};
+  g2s::install_interrupt_cleanup();
   app.require_subcommand(1);
   app.set_version_flag("--version", "g2s 0.1.0");
   g2s::cli::add_mesh_command(app);

@@ -46,6 +46,10 @@ enum class MeshFormat { stl_binary, stl_ascii, ply_binary };
 // The format for an output path: .ply -> ply_binary, otherwise STL (ascii when asked).
 MeshFormat mesh_format_for(const std::filesystem::path& path, bool ascii_stl);
 
+// Makes SIGINT and SIGTERM remove every open AtomicFile's temporary, print a message and exit
+// with Exit::interrupted (130). For programs; a library user may keep its own handlers.
+void install_interrupt_cleanup();
+
 // A file that appears at its target path only when complete: writes go through a 1 MiB buffer
 // to a temporary ".NAME.tmp-<pid>-<n>" in the same folder; write_at patches bytes already
 // written (flushed or still buffered); commit() flushes, closes (checking the result; no fsync)
@@ -74,6 +78,7 @@ class AtomicFile {
   std::vector<char> buffer_;
   std::uint64_t written_ = 0;  // bytes handed to the OS
   bool committed_ = false;
+  int registry_slot_ = -1;  // in the interrupt handler's list of temporaries
 };
 
 // Streams triangles to STL (binary or ASCII) as they come: memory stays constant whatever the

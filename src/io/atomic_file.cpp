@@ -13,6 +13,7 @@
 
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
+#include "io/temp_registry.hpp"
 
 namespace g2s {
 namespace {
@@ -40,12 +41,14 @@ AtomicFile::AtomicFile(const std::filesystem::path& target) : target_(target) {
                fmt::format(".{}.tmp-{}-{}", name, static_cast<long>(::getpid()), g_counter++);
   fd_ = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
   if (fd_ < 0) fail_write(target_, "cannot create", errno);
+  registry_slot_ = register_temporary(temporary_.c_str());
   buffer_.reserve(kBufferSize);
 }
 
 AtomicFile::~AtomicFile() {
   if (fd_ >= 0) ::close(fd_);
   if (!committed_ && !temporary_.empty()) ::unlink(temporary_.c_str());
+  unregister_temporary(registry_slot_);
 }
 
 void AtomicFile::flush_buffer() {
@@ -124,6 +127,8 @@ void AtomicFile::commit() {
   if (::rename(temporary_.c_str(), target_.c_str()) != 0)
     fail_write(target_, "cannot rename into place", errno);
   committed_ = true;
+  unregister_temporary(registry_slot_);
+  registry_slot_ = -1;
 }
 
 }  // namespace g2s
