@@ -149,6 +149,10 @@ void add_mesh_command(CLI::App& app) {
                   "Largest angle in degrees between neighbouring triangle normals (default 135); "
                   "lower it on noisy scans to avoid folds, raise it for very sharp edges")
       ->check(CLI::Range(10.0, 179.0));
+  cmd->add_option("--max-radius", args->options.max_radius,
+                  "Largest search ball, in sampling spacings (default 6); larger bridges wider "
+                  "gaps and scan borders, at a cost in speed on sparse or noisy regions")
+      ->check(CLI::Range(1.0, 1000.0));
   cmd->add_flag(
       "--no-orient", [args](std::int64_t) { args->options.orient = false; },
       "Keep each component's seed orientation instead of facing closed ones outward");

@@ -15,7 +15,7 @@ namespace g2s {
 
 struct MeshOptions {
   // Search radius levels (ALGORITHM.md §5): the front search ball has radius
-  // step * max(|ab|, min_edge_fraction * spacing), tried in increasing order.
+  // step * max(|ab|, spacing / 2) (at most max_radius spacings), tried in increasing order.
   std::vector<double> radius_steps{1.0, 1.5, 2.0, 3.0};
   // Flatness levels m: the fold angle beta in [0, max_fold_deg] quantised into m levels.
   int flatness_levels = 4;
@@ -26,7 +26,8 @@ struct MeshOptions {
   double max_radius = 6.0;
   // Seed search ball radius, in nearest-neighbour edge lengths (§3).
   double seed_ball = 2.5;
-  // Orient each closed component outward (open ones away from the cloud centre).
+  // Orient each closed component outward (open, mostly horizontal ones up; see
+  // docs/algorithm.md §6).
   bool orient = true;
   // Called now and then while growing with (points used so far, points in total); may be empty.
   std::function<void(std::uint64_t, std::uint64_t)> progress;
