@@ -58,6 +58,7 @@ class Grower {
         seed_tried_(grid.size(), 0),
         open_count_(grid.size(), 0),
         queue_(std::max(1, levels_ * flat_levels_)),
+        last_priority_(std::max(1, levels_ * flat_levels_) - 1),
         max_fold_(options.max_fold_deg * std::numbers::pi / 180.0),
         cos_max_fold_(std::cos(max_fold_)),
         radius_floor_(0.5 * grid.spacing()),
@@ -127,8 +128,15 @@ class Grower {
       // Gabriel point's ball is then no longer empty.)
       const Candidate c = find_candidate(e);
       if (c.point == kNoIndex) continue;
-      if (c.priority > level) {
-        queue_.push(c.priority, {e.a, e.b, e.triangle, c.point});
+      int priority = c.priority;
+      // Touching a used point only at the vertex starts a second fan there: wait until the
+      // last level, when the fronts around it may have joined it along an edge instead.
+      if (used_[c.point] && edges_.find(e.a, c.point) == EdgeMap::kMissing &&
+          edges_.find(c.point, e.b) == EdgeMap::kMissing) {
+        priority = last_priority_;
+      }
+      if (priority > level) {
+        queue_.push(priority, {e.a, e.b, e.triangle, c.point});
         continue;
       }
       try_add(e, c.point);
@@ -322,6 +330,7 @@ class Grower {
   std::vector<std::uint32_t> open_count_;
   std::uint64_t used_count_ = 0;
   BucketQueue<FrontEdge> queue_;
+  const int last_priority_;
   const double max_fold_;
   const double cos_max_fold_;
   const double radius_floor_;
