@@ -32,7 +32,9 @@ struct Baseline {
 };
 
 // So that test listings name the cloud rather than dump the struct's bytes.
-void PrintTo(const Baseline& b, std::ostream* os) { *os << b.name; }
+void PrintTo(const Baseline& b, std::ostream* os) {
+  *os << b.name;
+}
 
 class RealScan : public ::testing::TestWithParam<Baseline> {};
 
@@ -72,19 +74,19 @@ TEST_P(RealScan, MeshIsManifoldOrientedAndMeetsItsBaseline) {
   EXPECT_LE(s.holes, b.max_holes);
 }
 
-// Baselines measured at commit "one Gabriel candidate per edge" (default options), with about 5%
-// slack on boundary edges and holes and 0.2% on coverage. Lower them when the mesher improves.
-// closed-bunny-zipper's scan itself has 5 holes in its base (223 boundary edges).
+// Baselines measured at commit "a triangle that would start a second fan waits" (defaults), with
+// about 5% slack on boundary edges and holes and 0.2% on coverage. Lower them when the mesher
+// improves. closed-bunny-zipper's scan itself has 5 holes in its base (223 boundary edges).
 INSTANTIATE_TEST_SUITE_P(
     SharedData, RealScan,
     ::testing::Values(Baseline{"closed-kitten", true, 0.995, 0, 0},
                       Baseline{"closed-bunny-zipper", true, 0.995, 300, 10},
-                      Baseline{"open-bunny-scan-bun000", false, 0.998, 810, 25},
-                      Baseline{"raw-bunny", false, 0.987, 56400, 7800},
-                      Baseline{"open-table-mug-stereo", false, 0.991, 12000, 1240},
-                      Baseline{"open-lion-photogrammetry", false, 0.993, 29000, 2380},
-                      Baseline{"open-autzen-lidar", false, 0.989, 13850, 810},
-                      Baseline{"open-alpe-selle-photogrammetry", false, 0.975, 3360000, 130500}),
+                      Baseline{"open-bunny-scan-bun000", false, 0.998, 800, 22},
+                      Baseline{"raw-bunny", false, 0.992, 47500, 5900},
+                      Baseline{"open-table-mug-stereo", false, 0.992, 11200, 1050},
+                      Baseline{"open-lion-photogrammetry", false, 0.995, 27000, 1980},
+                      Baseline{"open-autzen-lidar", false, 0.991, 13150, 710},
+                      Baseline{"open-alpe-selle-photogrammetry", false, 0.987, 2980000, 105000}),
     [](const ::testing::TestParamInfo<Baseline>& param) {
       std::string name = param.param.name;
       for (char& c : name) {
