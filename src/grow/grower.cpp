@@ -129,17 +129,18 @@ class Grower {
       const Candidate c = find_candidate(e);
       if (c.point == kNoIndex) continue;
       int priority = c.priority;
+      const std::uint32_t on_ap = used_[c.point] ? edges_.find(e.a, c.point) : EdgeMap::kMissing;
+      const std::uint32_t on_pb = used_[c.point] ? edges_.find(c.point, e.b) : EdgeMap::kMissing;
       // Touching a used point only at the vertex starts a second fan there: wait until the
       // last level, when the fronts around it may have joined it along an edge instead.
-      if (used_[c.point] && edges_.find(e.a, c.point) == EdgeMap::kMissing &&
-          edges_.find(c.point, e.b) == EdgeMap::kMissing) {
+      if (used_[c.point] && on_ap == EdgeMap::kMissing && on_pb == EdgeMap::kMissing) {
         priority = last_priority_;
       }
       if (priority > level) {
         queue_.push(priority, {e.a, e.b, e.triangle, c.point});
         continue;
       }
-      try_add(e, c.point);
+      try_add(e, c.point, on_ap, on_pb);
     }
   }
 
@@ -239,9 +240,13 @@ class Grower {
   // Adds triangle (b, a, p) across front edge a->b if the Point-Edge Map allows it: no edge gets
   // a third triangle, shared edges are traversed in opposite directions, no duplicate, no fold.
   bool try_add(const FrontEdge& e, Index p) {
+    if (!used_[p]) return try_add(e, p, EdgeMap::kMissing, EdgeMap::kMissing);
+    return try_add(e, p, edges_.find(e.a, p), edges_.find(p, e.b));
+  }
+
+  // The same with the Point-Edge Map entries of (a, p) and (p, b) already looked up.
+  bool try_add(const FrontEdge& e, Index p, std::uint32_t on_ap, std::uint32_t on_pb) {
     if (interior(p) || p == e.a || p == e.b) return false;
-    const std::uint32_t on_ap = edges_.find(e.a, p);
-    const std::uint32_t on_pb = edges_.find(p, e.b);
     if (on_ap != EdgeMap::kMissing) {
       if ((on_ap & EdgeMap::kClosed) || on_ap == e.triangle) return false;
       if (!traverses(triangles_[on_ap], p, e.a)) return false;
