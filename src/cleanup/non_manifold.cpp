@@ -9,17 +9,9 @@
 #include <numeric>
 
 #include "cleanup/cleanup.hpp"
+#include "common/union_find.hpp"
 
 namespace g2s {
-namespace {
-
-std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t x) {
-  while (parent[x] != x) x = parent[x] = parent[parent[x]];
-  return x;
-}
-
-}  // namespace
-
 NonManifoldReport remove_non_manifold_vertices(std::vector<Triangle>& triangles,
                                                std::size_t vertex_count) {
   std::vector<Index> all(vertex_count);

@@ -8,17 +8,9 @@
 
 #include "cleanup/cleanup.hpp"
 #include "common/edge_map.hpp"
+#include "common/union_find.hpp"
 
 namespace g2s {
-namespace {
-
-std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t x) {
-  while (parent[x] != x) x = parent[x] = parent[parent[x]];
-  return x;
-}
-
-}  // namespace
-
 std::vector<std::array<Index, 2>> open_edges(const std::vector<Triangle>& triangles,
                                              std::size_t vertex_count) {
   EdgeMap edges(vertex_count);

@@ -62,7 +62,10 @@ HashGrid::HashGrid(std::span<const float> xyz, std::span<const Index> ids) {
       hi[a] = std::max<double>(hi[a], xyz[3 * i + a]);
     }
   }
-  for (int a = 0; a < 3; ++a) origin_[a] = lo[a];
+  for (int a = 0; a < 3; ++a) {
+    origin_[a] = lo[a];
+    extent_[a] = hi[a] - lo[a];
+  }
   const double dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
   const double extent = std::max({dx, dy, dz});
   // A surface spanning the box has an area of the order of its largest faces.
@@ -87,9 +90,7 @@ void HashGrid::build(std::span<const float> xyz, std::span<const Index> ids, dou
   inv_cell_ = 1.0 / cell;
   std::int64_t max_dim = 1;
   for (int a = 0; a < 3; ++a) {
-    double hi = origin_[a];
-    for (std::size_t i = 0; i < n; ++i) hi = std::max<double>(hi, xyz[3 * i + a]);
-    dims_[a] = std::min(cell_coord(hi, a) + 1, kMaxDim + 1);
+    dims_[a] = std::min(cell_coord(origin_[a] + extent_[a], a) + 1, kMaxDim + 1);
     max_dim = std::max(max_dim, dims_[a]);
   }
 

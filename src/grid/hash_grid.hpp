@@ -65,7 +65,8 @@ class HashGrid {
   std::vector<Slot> slots_;                // open addressing, linear probing, load <= 1/2
   std::uint64_t slot_mask_ = 0;
   int slot_shift_ = 64;  // 64 - log2(slots / 64): the top bits of the product are the best mixed
-  double origin_[3] = {0, 0, 0};
+  double origin_[3] = {0, 0, 0};  // bounding box: lowest corner
+  double extent_[3] = {0, 0, 0};  // and size
   double cell_ = 1.0;
   double inv_cell_ = 1.0;
   std::int64_t dims_[3] = {1, 1, 1};
