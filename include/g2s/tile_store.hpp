@@ -1,0 +1,92 @@
+// The tile store (src/tiling/, ALGORITHM.md §7.1, docs/tile-store.md): a cloud cut once into
+// spatial point tiles on disk, so that each stage of the out-of-core pipeline loads only the
+// tiles it works on. One file: a versioned header, the tile table, then one block per tile
+// holding its points (double x, y, z) with their global ids, raw or zstd-compressed, each with
+// a checksum. Within a block, points are ordered by increasing distance to the tile's box
+// boundary, so the halo a neighbour needs is a prefix of the block.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "g2s/io.hpp"
+#include "g2s/types.hpp"
+
+namespace g2s {
+
+// An axis-aligned box. A tile owns the points p with lo <= p < hi on every axis; the tiles of a
+// store partition the cloud's bounding box (the outermost faces lie on it and own their points).
+struct TileBox {
+  double lo[3] = {0, 0, 0};
+  double hi[3] = {0, 0, 0};
+};
+
+struct TileInfo {
+  TileBox box;
+  std::uint64_t points = 0;  // points stored in the tile
+  double spacing = 0.0;      // estimated mean nearest-neighbour spacing of its points (0 if < 2)
+};
+
+struct TileStoreOptions {
+  std::uint64_t tile_points = std::uint64_t{1} << 20;  // no tile holds more (adaptive split)
+  bool compress = false;                               // zstd-compress the point blocks
+  int zstd_level = 1;
+  // Called now and then with (points done, points in total) while writing; may be empty.
+  std::function<void(std::uint64_t, std::uint64_t)> progress;
+};
+
+struct TileStoreReport {
+  ReadReport read;  // what the input reader saw (format, finite and non-finite points)
+  std::uint64_t tiles = 0;
+  std::uint64_t bytes = 0;  // size of the store file
+};
+
+// Reads `input` (any format read_points accepts) in streaming passes with bounded memory and
+// writes the store atomically at `store` (temporary name, renamed when complete). Global ids
+// are the points' order among the finite points of the input, as read_points numbers them.
+// Deterministic: the same input and options give the same bytes. Throws Error(bad_input) for
+// a bad input and Error(write_failed) when the store cannot be written.
+TileStoreReport build_tile_store(const std::filesystem::path& input,
+                                 const std::filesystem::path& store,
+                                 const TileStoreOptions& options);
+
+// The points of one tile (or a border prefix of it): xyz holds 3 doubles per point, ids their
+// global ids.
+struct TilePoints {
+  std::vector<double> xyz;
+  std::vector<Index> ids;
+  std::size_t size() const { return ids.size(); }
+};
+
+// A store opened for reading: the header and table are validated on open; a block's checksum
+// is checked each time it is loaded. Any corruption, truncation or version mismatch throws
+// Error(bad_input, "<store>: ...") naming what is wrong. Safe to load from several threads.
+class TileStore {
+ public:
+  explicit TileStore(const std::filesystem::path& store);
+  ~TileStore();
+  TileStore(const TileStore&) = delete;
+  TileStore& operator=(const TileStore&) = delete;
+
+  const std::filesystem::path& path() const;
+  std::uint64_t point_count() const;  // points in all tiles
+  const TileBox& bounds() const;      // bounding box of all points
+  std::span<const TileInfo> tiles() const;
+  const ReadReport& input_report() const;  // as build_tile_store saw the input
+
+  // All points of a tile.
+  TilePoints load(std::size_t tile) const;
+  // The points of a tile within `distance` of its box's boundary (the halo its neighbours
+  // need): a prefix of the block, so only that part is read (and decompressed).
+  TilePoints load_border(std::size_t tile, double distance) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace g2s
