@@ -11,6 +11,7 @@
 #include <numbers>
 
 #include "common/edge_map.hpp"
+#include "common/union_find.hpp"
 #include "grow/bucket_queue.hpp"
 
 namespace g2s {
@@ -48,9 +49,10 @@ Index apex(const Triangle& t, Index u, Index v) {
 
 class Grower {
  public:
-  Grower(const HashGrid& grid, const MeshOptions& options)
+  Grower(const HashGrid& grid, const MeshOptions& options, const GrowContext& context)
       : grid_(grid),
         options_(options),
+        growable_(context.growable),
         levels_(static_cast<int>(options.radius_steps.size())),
         flat_levels_(std::max(1, options.flatness_levels)),
         edges_(grid.size()),
@@ -66,15 +68,25 @@ class Grower {
     triangles_.reserve(std::size_t{2} * grid.size());
   }
 
-  GrowResult run() {
+  GrowResult run(std::span<const Triangle> preload) {
     GrowResult result;
+    load(preload);
+    drain();
     for (std::uint32_t i = 0; i < grid_.size(); ++i) {
-      if (used_[i] || seed_tried_[i]) continue;
+      if (used_[i] || seed_tried_[i] || !growable(i)) continue;
       seed_tried_[i] = 1;
       if (!try_seed(i)) continue;
       ++result.seeds;
       drain();
     }
+    result.group.resize(triangles_.size());
+    result.flip.resize(triangles_.size());
+    for (std::size_t t = 0; t < triangles_.size(); ++t) {
+      const auto [root, parity] = groups_.find(group_[t]);
+      result.group[t] = root;
+      result.flip[t] = parity ^ flip_[t];
+    }
+    triangles_.erase(triangles_.begin(), triangles_.begin() + static_cast<long>(preloaded_));
     result.triangles = std::move(triangles_);
     result.second_fans = std::move(second_fans_);
     return result;
@@ -82,6 +94,58 @@ class Grower {
 
  private:
   bool interior(Index i) const { return used_[i] && open_count_[i] == 0; }
+  bool growable(Index i) const { return growable_.empty() || growable_[i]; }
+
+  // Enters the triangles kept before this run, each its own orientation group (joined where they
+  // share an edge); their open edges at growable points become the front.
+  void load(std::span<const Triangle> preload) {
+    for (const Triangle& t : preload) {
+      add_triangle(t[0], t[1], t[2], groups_.add(), 0, false);
+    }
+    preloaded_ = preload.size();
+    for (std::uint32_t t = 0; t < preloaded_; ++t) {
+      for (int k = 0; k < 3; ++k) {
+        const Index u = triangles_[t][k], v = triangles_[t][(k + 1) % 3];
+        const std::uint32_t on = edges_.find(u, v);
+        if (on == t && (growable(u) || growable(v))) queue_.push(0, {u, v, t, kNoIndex});
+      }
+    }
+  }
+
+  // Whether a new triangle (b, a, p) grown from front triangle `from` can share its edges with
+  // triangles ap and pb (EdgeMap::kMissing: none) without contradicting how the orientation
+  // groups already face; if so the groups are joined. Raw corners shared in the same direction
+  // are fine across groups that can still be flipped relative to each other.
+  bool join_groups(std::uint32_t from, Index a, Index p, Index b, std::uint32_t ap,
+                   std::uint32_t pb) {
+    struct Link {
+      std::uint32_t root;
+      std::uint8_t parity;  // the parity the link requires between the new triangle's root and root
+    };
+    const auto [root, parity] = groups_.find(group_[from]);
+    const std::uint8_t own = parity ^ flip_[from];
+    Link links[2];
+    int count = 0;
+    const std::pair<std::uint32_t, bool> shared[2] = {{ap, ap != EdgeMap::kMissing &&
+                                                               traverses(triangles_[ap], p, a)},
+                                                      {pb, pb != EdgeMap::kMissing &&
+                                                               traverses(triangles_[pb], b, p)}};
+    for (const auto& [t, opposite] : shared) {
+      if (t == EdgeMap::kMissing) continue;
+      const auto [r, pr] = groups_.find(group_[t]);
+      const std::uint8_t need = static_cast<std::uint8_t>(own ^ pr ^ flip_[t] ^ !opposite);
+      if (r == root) {
+        if (need != 0) return false;
+      } else {
+        for (int k = 0; k < count; ++k) {
+          if (links[k].root == r && links[k].parity != need) return false;
+        }
+        links[count++] = {r, need};
+      }
+    }
+    for (int k = 0; k < count; ++k) groups_.unite(root, links[k].root, links[k].parity);
+    return true;
+  }
 
   Vec3 normal_of(std::uint32_t t) const {
     const Triangle& tri = triangles_[t];
@@ -89,22 +153,30 @@ class Grower {
     return normalized(cross(grid_.position(tri[1]) - a, grid_.position(tri[2]) - a));
   }
 
-  // Appends triangle (a, b, c) and updates the Point-Edge Map, the open-edge counts and the front.
-  void add_triangle(Index a, Index b, Index c) {
+  // Appends triangle (a, b, c) in orientation group `group` and updates the Point-Edge Map, the
+  // open-edge counts and (when `grow`) the front.
+  void add_triangle(Index a, Index b, Index c, std::uint32_t group, std::uint8_t flip,
+                    bool grow = true) {
     const auto t = static_cast<std::uint32_t>(triangles_.size());
     triangles_.push_back({a, b, c});
+    group_.push_back(group);
+    flip_.push_back(flip);
     const Index corners[3] = {a, b, c};
     for (int k = 0; k < 3; ++k) {
       const Index u = corners[k], v = corners[(k + 1) % 3];
-      const bool existed = edges_.find(u, v) != EdgeMap::kMissing;
+      const std::uint32_t other = edges_.find(u, v);
       edges_.add(u, v, t);
-      if (existed) {
+      if (other != EdgeMap::kMissing) {
         --open_count_[u];
         --open_count_[v];
+        if (!grow) {  // preloaded neighbours: record how their groups face
+          groups_.unite(group, group_[other & ~EdgeMap::kClosed],
+                        static_cast<std::uint8_t>(!traverses(triangles_[other & ~EdgeMap::kClosed], v, u)));
+        }
       } else {
         ++open_count_[u];
         ++open_count_[v];
-        queue_.push(0, {u, v, t, kNoIndex});
+        if (grow) queue_.push(0, {u, v, t, kNoIndex});
       }
     }
     for (Index v : corners) {
@@ -226,12 +298,12 @@ class Grower {
         if (p == kNoIndex) break;
         const Vec3 n_new = normalized(cross(a - b, grid_.position(p) - b));
         const double beta = std::acos(std::clamp(dot(n, n_new), -1.0, 1.0));
-        if (beta <= max_fold_) {
+        if (beta <= max_fold_ && growable(p)) {
           const int flat =
               std::min(flat_levels_ - 1, static_cast<int>(beta / max_fold_ * flat_levels_));
           return {p, level * flat_levels_ + flat};
         }
-        break;  // a fold
+        break;  // a fold, or context the run may not use
       }
     }
     return {};
@@ -246,26 +318,32 @@ class Grower {
 
   // The same with the Point-Edge Map entries of (a, p) and (p, b) already looked up.
   bool try_add(const FrontEdge& e, Index p, std::uint32_t on_ap, std::uint32_t on_pb) {
-    if (interior(p) || p == e.a || p == e.b) return false;
+    if (interior(p) || !growable(p) || p == e.a || p == e.b) return false;
     if (on_ap != EdgeMap::kMissing) {
       if ((on_ap & EdgeMap::kClosed) || on_ap == e.triangle) return false;
-      if (!traverses(triangles_[on_ap], p, e.a)) return false;
     }
     if (on_pb != EdgeMap::kMissing) {
       if ((on_pb & EdgeMap::kClosed) || on_pb == e.triangle) return false;
-      if (!traverses(triangles_[on_pb], e.b, p)) return false;
       if (on_pb == on_ap) return false;
     }
     const Vec3 a = grid_.position(e.a), b = grid_.position(e.b);
     const Vec3 n_new = normalized(cross(a - b, grid_.position(p) - b));
     if (norm2(n_new) == 0) return false;
-    for (std::uint32_t t : {on_ap, on_pb}) {
-      if (t != EdgeMap::kMissing && dot(n_new, normal_of(t)) < cos_max_fold_) return false;
+    // A neighbour sharing the edge in the same direction will face the other way once the
+    // groups are joined: compare with its normal reversed.
+    if (on_ap != EdgeMap::kMissing) {
+      const double facing = traverses(triangles_[on_ap], p, e.a) ? 1.0 : -1.0;
+      if (facing * dot(n_new, normal_of(on_ap)) < cos_max_fold_) return false;
     }
+    if (on_pb != EdgeMap::kMissing) {
+      const double facing = traverses(triangles_[on_pb], e.b, p) ? 1.0 : -1.0;
+      if (facing * dot(n_new, normal_of(on_pb)) < cos_max_fold_) return false;
+    }
+    if (!join_groups(e.triangle, e.a, p, e.b, on_ap, on_pb)) return false;
     if (used_[p] && on_ap == EdgeMap::kMissing && on_pb == EdgeMap::kMissing) {
       second_fans_.push_back(p);
     }
-    add_triangle(e.b, e.a, p);
+    add_triangle(e.b, e.a, p, group_[e.triangle], flip_[e.triangle]);
     return true;
   }
 
@@ -274,7 +352,7 @@ class Grower {
   // on both sides (it does not bridge a thin part).
   bool try_seed(Index i) {
     const double spacing = std::max(grid_.spacing(), 1e-30);
-    const auto unused = [&](std::uint32_t j) { return !used_[j]; };
+    const auto unused = [&](std::uint32_t j) { return !used_[j] && growable(j); };
     const Index q = grid_.nearest(i, 4.0 * spacing, unused);
     if (q == kNoIndex) return false;
     const Vec3 p0 = grid_.position(i), p1 = grid_.position(q);
@@ -286,7 +364,7 @@ class Grower {
     });
     std::sort(near_.begin(), near_.end());
     for (const auto& [d2, r] : near_) {
-      if (r == i || r == q || used_[r]) continue;
+      if (r == i || r == q || used_[r] || !growable(r)) continue;
       const Vec3 p2 = grid_.position(r);
       Ball ball;
       if (!circumball(p0, p1, p2, ball)) continue;
@@ -317,7 +395,7 @@ class Grower {
         below |= h < -slack;
       }
       if (above && below) continue;
-      add_triangle(i, q, r);
+      add_triangle(i, q, r, groups_.add(), 0);
       return true;
     }
     return false;
@@ -325,9 +403,14 @@ class Grower {
 
   const HashGrid& grid_;
   const MeshOptions& options_;
+  const std::span<const std::uint8_t> growable_;
   const int levels_;
   const int flat_levels_;
-  std::vector<Triangle> triangles_;
+  std::vector<Triangle> triangles_;  // the preloaded ones first
+  std::size_t preloaded_ = 0;
+  std::vector<std::uint32_t> group_;  // per triangle: its orientation group
+  std::vector<std::uint8_t> flip_;    // per triangle: its parity within the group
+  ParityUnionFind groups_;
   std::vector<Index> second_fans_;
   EdgeMap edges_;
   std::vector<std::uint8_t> used_;
@@ -348,8 +431,9 @@ class Grower {
 
 }  // namespace
 
-GrowResult grow_mesh(const HashGrid& grid, const MeshOptions& options) {
-  return Grower(grid, options).run();
+GrowResult grow_mesh(const HashGrid& grid, const MeshOptions& options,
+                     const GrowContext& context) {
+  return Grower(grid, options, context).run(context.preload);
 }
 
 }  // namespace g2s

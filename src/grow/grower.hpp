@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "g2s/mesher.hpp"
@@ -9,16 +10,31 @@
 
 namespace g2s {
 
+// What a run starts from. Empty: a fresh tile, every point usable. The seam stitcher gives the
+// triangles already kept around the seam, whose open edges become the front, and marks which
+// points may join new triangles (the others are context for the Gabriel test only).
+struct GrowContext {
+  std::span<const Triangle> preload;       // in grid indices
+  std::span<const std::uint8_t> growable;  // per grid point, non-zero: usable; empty: all
+};
+
 struct GrowResult {
-  std::vector<Triangle> triangles;  // in grid indices; consistently oriented per component
+  std::vector<Triangle> triangles;  // the new triangles, in grid indices
+  // Orientation groups of the preloaded then the new triangles: triangles with the same group
+  // face consistently once those with flip set have two corners swapped. Fronts from different
+  // seeds (or tiles) may meet with either orientation; the groups record how they joined.
+  std::vector<std::uint32_t> group;
+  std::vector<std::uint8_t> flip;
   std::uint64_t seeds = 0;
   // Points where a triangle started a second fan (fronts meeting at a point): the only places a
   // non-manifold vertex can be, in the order they arose.
   std::vector<Index> second_fans;
 };
 
-// Grows triangles from seed triangles until no unused point can seed a new component.
-// Deterministic: depends only on the grid (which is independent of input order) and options.
-GrowResult grow_mesh(const HashGrid& grid, const MeshOptions& options);
+// Grows triangles from the preloaded front, then from seed triangles until no unused point can
+// seed a new component. Deterministic: depends only on the grid (which is independent of input
+// order), the context and the options.
+GrowResult grow_mesh(const HashGrid& grid, const MeshOptions& options,
+                     const GrowContext& context = {});
 
 }  // namespace g2s

@@ -44,6 +44,9 @@ TileMesh mesh_tile(std::span<const float> xyz, std::span<const Index> ids,
 
   t0 = std::chrono::steady_clock::now();
   std::vector<Triangle>& triangles = grown.triangles;
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    if (grown.flip[t]) std::swap(triangles[t][1], triangles[t][2]);
+  }
   const NonManifoldReport nm =
       remove_non_manifold_vertices_at(triangles, grid.size(), grown.second_fans);
   out.report.triangles_removed = nm.triangles_removed;
