@@ -68,9 +68,9 @@ class Grower {
     triangles_.reserve(std::size_t{2} * grid.size());
   }
 
-  GrowResult run(std::span<const Triangle> preload) {
+  GrowResult run(const GrowContext& context) {
     GrowResult result;
-    load(preload);
+    load(context.preload, context.preload_group);
     drain();
     for (std::uint32_t i = 0; i < grid_.size(); ++i) {
       if (used_[i] || seed_tried_[i] || !growable(i)) continue;
@@ -98,9 +98,24 @@ class Grower {
 
   // Enters the triangles kept before this run, each its own orientation group (joined where they
   // share an edge); their open edges at growable points become the front.
-  void load(std::span<const Triangle> preload) {
-    for (const Triangle& t : preload) {
-      add_triangle(t[0], t[1], t[2], groups_.add(), 0, false);
+  void load(std::span<const Triangle> preload, std::span<const std::uint32_t> labels) {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> label_group;  // sorted by label
+    for (std::size_t k = 0; k < preload.size(); ++k) {
+      std::uint32_t group = 0;
+      if (labels.empty()) {
+        group = groups_.add();
+      } else {
+        const auto at = std::lower_bound(label_group.begin(), label_group.end(),
+                                         std::pair{labels[k], 0u});
+        if (at != label_group.end() && at->first == labels[k]) {
+          group = at->second;
+        } else {
+          group = groups_.add();
+          label_group.insert(at, {labels[k], group});
+        }
+      }
+      const Triangle& t = preload[k];
+      add_triangle(t[0], t[1], t[2], group, 0, false);
     }
     preloaded_ = preload.size();
     for (std::uint32_t t = 0; t < preloaded_; ++t) {
@@ -433,7 +448,7 @@ class Grower {
 
 GrowResult grow_mesh(const HashGrid& grid, const MeshOptions& options,
                      const GrowContext& context) {
-  return Grower(grid, options, context).run(context.preload);
+  return Grower(grid, options, context).run(context);
 }
 
 }  // namespace g2s

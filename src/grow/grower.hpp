@@ -14,7 +14,10 @@ namespace g2s {
 // triangles already kept around the seam, whose open edges become the front, and marks which
 // points may join new triangles (the others are context for the Gabriel test only).
 struct GrowContext {
-  std::span<const Triangle> preload;       // in grid indices
+  std::span<const Triangle> preload;  // in grid indices
+  // Per preloaded triangle, a label: triangles with one label face consistently as given (they
+  // start in one orientation group); empty: every triangle its own group.
+  std::span<const std::uint32_t> preload_group;
   std::span<const std::uint8_t> growable;  // per grid point, non-zero: usable; empty: all
 };
 

@@ -1,0 +1,82 @@
+// Stage 1 of the tiled pipeline: one tile grown with a halo of its neighbours' points. The halo
+// lets G2S see across the tile's faces as if the cloud went on, so the triangles it keeps (those
+// with every corner in the tile) are the ones the whole cloud would give there; triangles that
+// reach into the halo are left to the seam stitcher. No triangle is kept by two tiles: its
+// corners lie in one tile only.
+#include <algorithm>
+#include <chrono>
+
+#include "g2s/pipeline.hpp"
+#include "grid/hash_grid.hpp"
+#include "grow/grower.hpp"
+#include "pipeline/tile_geometry.hpp"
+
+namespace g2s {
+
+TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::span<const TileInfo> tiles = source.tiles();
+  const TileBox& box = tiles[tile].box;
+  const double halo_first = options.halo_spacings * tiles[tile].spacing;
+  const std::vector<std::size_t> near0 = tiles_near(tiles, tile, halo_first);
+  const double halo = options.halo_spacings * local_spacing(tiles, tile, near0);
+
+  TilePoints points = source.load(tile);
+  const std::size_t own = points.size();
+  for (std::size_t j : tiles_near(tiles, tile, halo)) {
+    const TilePoints border = source.load_border(j, halo);
+    for (std::size_t k = 0; k < border.size(); ++k) {
+      if (box_distance(box, &border.xyz[3 * k]) > halo) continue;
+      points.ids.push_back(border.ids[k]);
+      points.xyz.insert(points.xyz.end(), &border.xyz[3 * k], &border.xyz[3 * k + 3]);
+    }
+  }
+  // Local float frame at the box centre (computed in double: georeferenced clouds keep their
+  // precision).
+  std::vector<float> local(points.xyz.size());
+  for (std::size_t k = 0; k < local.size(); ++k) {
+    const int a = static_cast<int>(k % 3);
+    local[k] = static_cast<float>(points.xyz[k] - 0.5 * (box.lo[a] + box.hi[a]));
+  }
+  std::vector<Index> own_ids(points.ids.begin(), points.ids.begin() + static_cast<long>(own));
+  std::sort(own_ids.begin(), own_ids.end());
+
+  TileGrowth out;
+  const HashGrid grid(local, points.ids);
+  out.report.points = own;
+  out.report.spacing = grid.spacing();
+  out.report.seconds_grid = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const auto grow_start = std::chrono::steady_clock::now();
+  GrowResult grown = grow_mesh(grid, options.mesh);
+  out.report.seeds = grown.seeds;
+
+  std::vector<std::uint8_t> mine(grid.size());
+  for (std::uint32_t k = 0; k < grid.size(); ++k) {
+    mine[k] = std::binary_search(own_ids.begin(), own_ids.end(), grid.id(k));
+  }
+  // Dense group numbers in order of first kept triangle: the same on every run.
+  std::vector<std::uint32_t> dense(grown.triangles.size(), kNoIndex);
+  for (std::size_t t = 0; t < grown.triangles.size(); ++t) {
+    Triangle tri = grown.triangles[t];
+    if (!mine[tri[0]] || !mine[tri[1]] || !mine[tri[2]]) {
+      // Leaving out a triangle that reaches into the halo can split a kept corner's fan in two.
+      for (Index v : tri) {
+        if (mine[v]) out.second_fans.push_back(grid.id(v));
+      }
+      continue;
+    }
+    if (grown.flip[t]) std::swap(tri[1], tri[2]);
+    std::uint32_t& group = dense[grown.group[t]];
+    if (group == kNoIndex) group = out.groups++;
+    out.triangles.push_back({grid.id(tri[0]), grid.id(tri[1]), grid.id(tri[2])});
+    out.group.push_back(group);
+  }
+  for (Index v : grown.second_fans) {
+    if (mine[v]) out.second_fans.push_back(grid.id(v));
+  }
+  out.report.triangles_grown = out.triangles.size();
+  out.report.seconds_grow = std::chrono::duration<double>(std::chrono::steady_clock::now() - grow_start).count();
+  return out;
+}
+
+}  // namespace g2s

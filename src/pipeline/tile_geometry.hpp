@@ -1,0 +1,60 @@
+// Box geometry shared by the pipeline's stages: distances between points and tile boxes, the
+// tiles near a tile, and the local float frame a tile is meshed in.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <span>
+#include <vector>
+
+#include "g2s/tile_store.hpp"
+
+namespace g2s {
+
+inline double box_distance(const TileBox& box, const double* p) {
+  double d2 = 0;
+  for (int a = 0; a < 3; ++a) {
+    const double gap = std::max({box.lo[a] - p[a], 0.0, p[a] - box.hi[a]});
+    d2 += gap * gap;
+  }
+  return std::sqrt(d2);
+}
+
+inline double box_gap(const TileBox& a, const TileBox& b) {
+  double d2 = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double gap = std::max({a.lo[k] - b.hi[k], 0.0, b.lo[k] - a.hi[k]});
+    d2 += gap * gap;
+  }
+  return std::sqrt(d2);
+}
+
+inline bool box_contains(const TileBox& box, const double* p) {
+  for (int a = 0; a < 3; ++a) {
+    if (p[a] < box.lo[a] || p[a] > box.hi[a]) return false;
+  }
+  return true;
+}
+
+// The tiles other than `tile` whose boxes lie within `reach` of its box, in index order.
+inline std::vector<std::size_t> tiles_near(std::span<const TileInfo> tiles, std::size_t tile,
+                                           double reach) {
+  std::vector<std::size_t> near;
+  for (std::size_t j = 0; j < tiles.size(); ++j) {
+    if (j != tile && tiles[j].points > 0 && box_gap(tiles[tile].box, tiles[j].box) <= reach) {
+      near.push_back(j);
+    }
+  }
+  return near;
+}
+
+// The largest spacing of a tile and its neighbours: the unit of the halo and seam widths, so
+// that a sparse neighbour still gets a halo wide enough for its triangles.
+inline double local_spacing(std::span<const TileInfo> tiles, std::size_t tile,
+                            std::span<const std::size_t> near) {
+  double s = tiles[tile].spacing;
+  for (std::size_t j : near) s = std::max(s, tiles[j].spacing);
+  return s;
+}
+
+}  // namespace g2s
