@@ -1,7 +1,6 @@
 // g2s mesh: read a cloud, mesh it, write the mesh, print a summary and the mesh's defects.
 #include <fmt/core.h>
 #include <sys/resource.h>
-#include <tbb/global_control.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -11,6 +10,7 @@
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
 #include "g2s/mesher.hpp"
+#include "g2s/pipeline.hpp"
 #include "g2s/stats.hpp"
 
 namespace g2s::cli {
@@ -24,7 +24,8 @@ struct MeshArgs {
   bool quiet = false;
   bool json = false;
   bool no_stats = false;
-  MeshOptions options;
+  std::uint64_t tile_points = std::uint64_t{1} << 20;
+  PipelineOptions options;
 };
 
 double peak_rss_mb() {
@@ -54,11 +55,7 @@ class Progress {
 };
 
 void run_mesh(MeshArgs& args) {
-  std::unique_ptr<tbb::global_control> threads;
-  if (args.threads > 0) {
-    threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                    static_cast<std::size_t>(args.threads));
-  }
+  args.options.threads = args.threads;
   Progress progress(!args.quiet && !args.json);
   const auto t0 = std::chrono::steady_clock::now();
   progress.stage("reading", 0);
@@ -69,10 +66,11 @@ void run_mesh(MeshArgs& args) {
                 fmt::format("{}: no usable points ({} read, {} non-finite)", args.input,
                             read_report.points + read_report.non_finite, read_report.non_finite));
   }
-  args.options.progress = [&](std::uint64_t used, std::uint64_t total) {
-    progress.stage("meshing", static_cast<double>(used) / static_cast<double>(total));
+  args.options.progress = [&](std::uint64_t done, std::uint64_t total) {
+    progress.stage("meshing", static_cast<double>(done) / static_cast<double>(total));
   };
-  TileMesh mesh = mesh_cloud(cloud, args.options);
+  const MemoryTiles tiles(cloud, args.tile_points);
+  PipelineMesh mesh = mesh_tiles(tiles, args.options);
   if (mesh.triangles.empty()) {
     throw Error(Exit::bad_input,
                 fmt::format("{}: no triangle could be formed from {} points (too few, collinear "
@@ -98,10 +96,11 @@ void run_mesh(MeshArgs& args) {
         "\"duplicates_merged\":{},\"spacing\":{},\"seeds\":{},\"triangles\":{},"
         "\"triangles_removed\":{},\"seconds\":{:.3f},\"seconds_grid\":{:.3f},"
         "\"seconds_grow\":{:.3f},\"seconds_cleanup\":{:.3f},\"ktriangles_per_second\":{:.1f},"
-        "\"peak_rss_mb\":{:.1f}",
+        "\"peak_rss_mb\":{:.1f},\"tiles\":{},\"triangles_stitched\":{},\"seconds_stitch\":{:.3f}",
         args.input, args.output, r.points, read_report.non_finite, r.duplicates_merged, r.spacing,
         r.seeds, r.triangles_grown - r.triangles_removed, r.triangles_removed, seconds,
-        r.seconds_grid, r.seconds_grow, r.seconds_cleanup, ktps, peak_rss_mb());
+        r.seconds_grid, r.seconds_grow, r.seconds_cleanup, ktps, peak_rss_mb(), mesh.tiles,
+        mesh.triangles_stitched, mesh.seconds_stitch);
     if (!args.no_stats) fmt::print(",\"stats\":{}", stats_to_json(stats));
     fmt::print("}}\n");
     return;
@@ -137,24 +136,28 @@ void add_mesh_command(CLI::App& app) {
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
   cmd->add_flag("--json", args->json, "Print the summary as one JSON object on stdout");
   cmd->add_flag("--no-stats", args->no_stats, "Skip measuring the mesh's defects");
-  cmd->add_option("--radius-steps", args->options.radius_steps,
+  cmd->add_option("--tile-points", args->tile_points,
+                  "Largest number of points in a tile (default 1048576): clouds are cut into "
+                  "tiles grown in parallel and stitched at the seams")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--radius-steps", args->options.mesh.radius_steps,
                   "Search radius levels, in edge lengths, increasing (default 1 1.5 2 3); "
                   "more levels close more gaps in sparse regions, at some cost in speed")
       ->expected(1, 16);
-  cmd->add_option("--flatness-levels", args->options.flatness_levels,
+  cmd->add_option("--flatness-levels", args->options.mesh.flatness_levels,
                   "Flatness levels m of the priority queue (default 4); more levels mesh flat "
                   "regions first more strictly")
       ->check(CLI::Range(1, 64));
-  cmd->add_option("--max-fold", args->options.max_fold_deg,
+  cmd->add_option("--max-fold", args->options.mesh.max_fold_deg,
                   "Largest angle in degrees between neighbouring triangle normals (default 135); "
                   "lower it on noisy scans to avoid folds, raise it for very sharp edges")
       ->check(CLI::Range(10.0, 179.0));
-  cmd->add_option("--max-radius", args->options.max_radius,
+  cmd->add_option("--max-radius", args->options.mesh.max_radius,
                   "Largest search ball, in sampling spacings (default 6); larger bridges wider "
                   "gaps and scan borders, at a cost in speed on sparse or noisy regions")
       ->check(CLI::Range(1.0, 1000.0));
   cmd->add_flag(
-      "--no-orient", [args](std::int64_t) { args->options.orient = false; },
+      "--no-orient", [args](std::int64_t) { args->options.mesh.orient = false; },
       "Keep each component's seed orientation instead of facing closed ones outward");
   cmd->callback([args] { run_mesh(*args); });
 }

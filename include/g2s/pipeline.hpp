@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -61,6 +62,11 @@ struct PipelineOptions {
   // neighbours' points this far out; a seam is stitched over the points this close to it.
   double halo_spacings = 8.0;
   double band_spacings = 6.0;
+  // Points, in Gabriel order, a seam edge tries after its Gabriel point fails to join.
+  int stitch_retries = 4;
+  // Called now and then with (tiles done, tiles in total), from one thread at a time, while
+  // growing and stitching (each tile counts twice); may be empty. mesh.progress is not used.
+  std::function<void(std::uint64_t, std::uint64_t)> progress;
 };
 
 // Grows one tile with its halo. Deterministic; independent of the other tiles.

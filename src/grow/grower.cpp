@@ -53,6 +53,7 @@ class Grower {
       : grid_(grid),
         options_(options),
         growable_(context.growable),
+        retries_(context.retries),
         levels_(static_cast<int>(options.radius_steps.size())),
         flat_levels_(std::max(1, options.flatness_levels)),
         edges_(grid.size()),
@@ -105,8 +106,8 @@ class Grower {
       if (labels.empty()) {
         group = groups_.add();
       } else {
-        const auto at = std::lower_bound(label_group.begin(), label_group.end(),
-                                         std::pair{labels[k], 0u});
+        const auto at =
+            std::lower_bound(label_group.begin(), label_group.end(), std::pair{labels[k], 0u});
         if (at != label_group.end() && at->first == labels[k]) {
           group = at->second;
         } else {
@@ -141,10 +142,9 @@ class Grower {
     const std::uint8_t own = parity ^ flip_[from];
     Link links[2];
     int count = 0;
-    const std::pair<std::uint32_t, bool> shared[2] = {{ap, ap != EdgeMap::kMissing &&
-                                                               traverses(triangles_[ap], p, a)},
-                                                      {pb, pb != EdgeMap::kMissing &&
-                                                               traverses(triangles_[pb], b, p)}};
+    const std::pair<std::uint32_t, bool> shared[2] = {
+        {ap, ap != EdgeMap::kMissing && traverses(triangles_[ap], p, a)},
+        {pb, pb != EdgeMap::kMissing && traverses(triangles_[pb], b, p)}};
     for (const auto& [t, opposite] : shared) {
       if (t == EdgeMap::kMissing) continue;
       const auto [r, pr] = groups_.find(group_[t]);
@@ -185,8 +185,9 @@ class Grower {
         --open_count_[u];
         --open_count_[v];
         if (!grow) {  // preloaded neighbours: record how their groups face
-          groups_.unite(group, group_[other & ~EdgeMap::kClosed],
-                        static_cast<std::uint8_t>(!traverses(triangles_[other & ~EdgeMap::kClosed], v, u)));
+          groups_.unite(
+              group, group_[other & ~EdgeMap::kClosed],
+              static_cast<std::uint8_t>(!traverses(triangles_[other & ~EdgeMap::kClosed], v, u)));
         }
       } else {
         ++open_count_[u];
@@ -209,6 +210,10 @@ class Grower {
       if (edges_.find(e.a, e.b) != e.triangle) continue;  // closed meanwhile
       if (e.cand != kNoIndex) {
         if (!interior(e.cand) && try_add(e, e.cand)) continue;
+        if (retries_ > 0) {
+          retry(e, e.cand);
+          continue;
+        }
       }
       // One candidate per edge: if it cannot join, the edge stays open unless a neighbour
       // closes it. (Retrying with the next-best point was measured to give worse meshes: the
@@ -227,8 +232,26 @@ class Grower {
         queue_.push(priority, {e.a, e.b, e.triangle, c.point});
         continue;
       }
-      try_add(e, c.point, on_ap, on_pb);
+      if (!try_add(e, c.point, on_ap, on_pb) && retries_ > 0) retry(e, c.point);
     }
+  }
+
+  // Stitching only: between two meshes that are already fixed, an edge whose Gabriel point
+  // cannot join would leave a crack, so the next points in Gabriel order are tried.
+  void retry(const FrontEdge& e, Index failed) {
+    excluded_.assign(1, failed);
+    for (int k = 0; k < retries_; ++k) {
+      const Candidate c = find_candidate(e);
+      if (c.point == kNoIndex) break;
+      const bool used = used_[c.point];
+      const std::uint32_t on_ap = used ? edges_.find(e.a, c.point) : EdgeMap::kMissing;
+      const std::uint32_t on_pb = used ? edges_.find(c.point, e.b) : EdgeMap::kMissing;
+      // Only a point that is free or closes the crack along an edge: not a second fan.
+      const bool fan = used && on_ap == EdgeMap::kMissing && on_pb == EdgeMap::kMissing;
+      if (!fan && try_add(e, c.point, on_ap, on_pb)) break;
+      excluded_.push_back(c.point);
+    }
+    excluded_.clear();
   }
 
   // The Gabriel walk over cand_: start at the candidate nearest the edge midpoint, move to the
@@ -292,6 +315,7 @@ class Grower {
       pool_.clear();
       grid_.for_each_in_ball(mid + out * along, radius, [&](std::uint32_t j, double) {
         if (j == e.a || j == e.b || j == c || interior(j)) return;
+        if (std::find(excluded_.begin(), excluded_.end(), j) != excluded_.end()) return;
         const Vec3 d = grid_.position(j) - mid;
         const double ahead = dot(d, out);
         if (ahead <= 0) return;
@@ -419,6 +443,7 @@ class Grower {
   const HashGrid& grid_;
   const MeshOptions& options_;
   const std::span<const std::uint8_t> growable_;
+  const int retries_;
   const int levels_;
   const int flat_levels_;
   std::vector<Triangle> triangles_;  // the preloaded ones first
@@ -441,13 +466,13 @@ class Grower {
   // Scratch, reused across edges so the inner loop does not allocate.
   std::vector<PoolPoint> pool_;
   std::vector<Index> cand_;
+  std::vector<Index> excluded_;  // points a retried edge has already failed with
   std::vector<std::pair<double, std::uint32_t>> near_;
 };
 
 }  // namespace
 
-GrowResult grow_mesh(const HashGrid& grid, const MeshOptions& options,
-                     const GrowContext& context) {
+GrowResult grow_mesh(const HashGrid& grid, const MeshOptions& options, const GrowContext& context) {
   return Grower(grid, options, context).run(context);
 }
 

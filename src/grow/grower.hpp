@@ -19,6 +19,8 @@ struct GrowContext {
   // start in one orientation group); empty: every triangle its own group.
   std::span<const std::uint32_t> preload_group;
   std::span<const std::uint8_t> growable;  // per grid point, non-zero: usable; empty: all
+  // How many more points, in Gabriel order, an edge tries when its Gabriel point cannot join.
+  int retries = 0;
 };
 
 struct GrowResult {

@@ -45,7 +45,8 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
   const HashGrid grid(local, points.ids);
   out.report.points = own;
   out.report.spacing = grid.spacing();
-  out.report.seconds_grid = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  out.report.seconds_grid =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const auto grow_start = std::chrono::steady_clock::now();
   GrowResult grown = grow_mesh(grid, options.mesh);
   out.report.seeds = grown.seeds;
@@ -75,7 +76,8 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
     if (mine[v]) out.second_fans.push_back(grid.id(v));
   }
   out.report.triangles_grown = out.triangles.size();
-  out.report.seconds_grow = std::chrono::duration<double>(std::chrono::steady_clock::now() - grow_start).count();
+  out.report.seconds_grow =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - grow_start).count();
   return out;
 }
 

@@ -16,9 +16,8 @@ PipelineMesh mesh_tiles(const TileSource& source, const PipelineOptions& options
                                                   static_cast<std::size_t>(options.threads));
   }
   std::vector<TileGrowth> growths(source.tiles().size());
-  tbb::parallel_for(std::size_t{0}, growths.size(), [&](std::size_t t) {
-    growths[t] = grow_tile(source, t, options);
-  });
+  tbb::parallel_for(std::size_t{0}, growths.size(),
+                    [&](std::size_t t) { growths[t] = grow_tile(source, t, options); });
   return stitch_tiles(source, std::move(growths), options);
 }
 

@@ -121,7 +121,10 @@ class SeamStitcher {
     std::vector<std::uint8_t> growable(grid.size());
     for (std::uint32_t k = 0; k < grid.size(); ++k) growable[k] = in_band_[grid.id(k)];
 
-    GrowResult grown = grow_mesh(grid, options_.mesh, {preload_, preload_group_, growable});
+    MeshOptions mesh_options = options_.mesh;
+    mesh_options.progress = {};
+    GrowResult grown = grow_mesh(grid, mesh_options,
+                                 {preload_, preload_group_, growable, options_.stitch_retries});
 
     // Orientation: per grower group, the first preloaded triangle anchors it to a kept group.
     const std::size_t preloaded = preload_.size();
@@ -131,8 +134,8 @@ class SeamStitcher {
     group_ids.erase(std::unique(group_ids.begin(), group_ids.end()), group_ids.end());
     std::vector<std::uint32_t> anchor_of(group_ids.size(), kNoIndex);
     auto slot = [&](std::uint32_t g) {
-      return static_cast<std::size_t>(
-          std::lower_bound(group_ids.begin(), group_ids.end(), g) - group_ids.begin());
+      return static_cast<std::size_t>(std::lower_bound(group_ids.begin(), group_ids.end(), g) -
+                                      group_ids.begin());
     };
     for (std::uint32_t k = 0; k < preloaded; ++k) {
       std::uint32_t& a = anchor_of[slot(grown.group[k])];
@@ -191,7 +194,8 @@ PipelineMesh stitch_tiles(const TileSource& source, std::vector<TileGrowth> grow
   for (std::size_t t = 0; t < tiles.size(); ++t) {
     const TilePoints points = source.load(t);
     for (std::size_t k = 0; k < points.size(); ++k) {
-      if (points.ids[k] >= n) throw Error(Exit::bad_input, "tile store: a point id is out of range");
+      if (points.ids[k] >= n)
+        throw Error(Exit::bad_input, "tile store: a point id is out of range");
       std::copy_n(&points.xyz[3 * k], 3, &out.xyz[3 * std::size_t{points.ids[k]}]);
     }
   }
@@ -213,16 +217,17 @@ PipelineMesh stitch_tiles(const TileSource& source, std::vector<TileGrowth> grow
   SeamStitcher stitcher(source, options, n);
   for (std::size_t t = 0; t < tiles.size(); ++t) {
     out.triangles_stitched += stitcher.stitch(t, out.xyz, kept);
+    if (options.progress) options.progress(tiles.size() + t + 1, 2 * tiles.size());
   }
   out.seconds_stitch = seconds_since(start);
 
   const auto cleanup_start = std::chrono::steady_clock::now();
   for (std::size_t t = 0; t < kept.triangles.size(); ++t) {
-    if (kept.groups.find(kept.group[t]).second) std::swap(kept.triangles[t][1], kept.triangles[t][2]);
+    if (kept.groups.find(kept.group[t]).second)
+      std::swap(kept.triangles[t][1], kept.triangles[t][2]);
   }
   out.report.triangles_grown = kept.triangles.size();
-  const NonManifoldReport nm =
-      remove_non_manifold_vertices_at(kept.triangles, n, kept.second_fans);
+  const NonManifoldReport nm = remove_non_manifold_vertices_at(kept.triangles, n, kept.second_fans);
   out.report.triangles_removed = nm.triangles_removed;
   out.report.non_manifold_vertices_fixed = nm.vertices_fixed;
   if (options.mesh.orient) {
