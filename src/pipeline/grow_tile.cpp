@@ -48,7 +48,9 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
   out.report.seconds_grid =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const auto grow_start = std::chrono::steady_clock::now();
-  GrowResult grown = grow_mesh(grid, options.mesh);
+  MeshOptions mesh_options = options.mesh;
+  mesh_options.progress = {};  // tiles grow in parallel; the pipeline reports per tile
+  GrowResult grown = grow_mesh(grid, mesh_options);
   out.report.seeds = grown.seeds;
 
   std::vector<std::uint8_t> mine(grid.size());
