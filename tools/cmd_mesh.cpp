@@ -1,17 +1,15 @@
 // g2s mesh: read a cloud, mesh it, write the mesh, print a summary and the mesh's defects.
 #include <fmt/core.h>
-#include <sys/resource.h>
 #include <tbb/global_control.h>
-#include <unistd.h>
 
 #include <chrono>
-#include <cstdio>
 
 #include "commands.hpp"
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
 #include "g2s/mesher.hpp"
 #include "g2s/stats.hpp"
+#include "progress.hpp"
 
 namespace g2s::cli {
 namespace {
@@ -25,32 +23,6 @@ struct MeshArgs {
   bool json = false;
   bool no_stats = false;
   MeshOptions options;
-};
-
-double peak_rss_mb() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
-}
-
-// A one-line progress bar on stderr, redrawn in place; only when stderr is a terminal.
-class Progress {
- public:
-  explicit Progress(bool enabled) : enabled_(enabled && isatty(STDERR_FILENO)) {}
-  void stage(const char* name, double fraction) {
-    if (!enabled_) return;
-    const int width = 30;
-    const int done = static_cast<int>(fraction * width + 0.5);
-    fmt::print(stderr, "\r{:<10} [{:<{}}] {:3.0f}%", name, std::string(done, '#'), width,
-               fraction * 100);
-    std::fflush(stderr);
-  }
-  void clear() {
-    if (enabled_) fmt::print(stderr, "\r{:60}\r", "");
-  }
-
- private:
-  bool enabled_;
 };
 
 void run_mesh(MeshArgs& args) {

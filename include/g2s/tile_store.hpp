@@ -83,6 +83,7 @@ class TileStore {
   const TileBox& bounds() const;      // bounding box of all points
   std::span<const TileInfo> tiles() const;
   const ReadReport& input_report() const;  // as build_tile_store saw the input
+  bool compressed() const;                 // blocks are zstd frames (for g2s tile-info)
 
   // All points of a tile.
   TilePoints load(std::size_t tile) const;

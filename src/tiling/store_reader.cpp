@@ -245,6 +245,9 @@ std::span<const TileInfo> TileStore::tiles() const {
 const ReadReport& TileStore::input_report() const {
   return impl_->input;
 }
+bool TileStore::compressed() const {
+  return impl_->compressed;
+}
 
 TilePoints TileStore::load(std::size_t tile) const {
   const unsigned char* table = impl_->frame_table(tile);

@@ -3,9 +3,19 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <numeric>
 
 namespace g2s::tiling {
+namespace {
+
+// A midpoint cut must leave each side this fraction (1/8) of the points, else the cut is at a
+// quantile. Lower fractions isolate dense clusters in smaller boxes but leave more, emptier
+// tiles (on the bun000 scan at 1000 points per tile: 1/4 gives 52 tiles, 1/8 gives 60, any
+// non-empty side 68, for 41 full ones).
+constexpr std::ptrdiff_t kMinShare = 8;
+
+}  // namespace
 
 void PointSample::shrink() {
   while (hashes_.size() > 2 * target_) {
@@ -31,7 +41,12 @@ bool TileTree::split(std::uint32_t node, const PointSample& sample, double weigh
 
 void TileTree::split_range(std::uint32_t node, const PointSample& sample, std::uint32_t* begin,
                            std::uint32_t* end, double weight, double target) {
-  if (static_cast<double>(end - begin) * weight <= target) return;
+  const double estimate = static_cast<double>(end - begin) * weight;
+  if (estimate <= target) return;
+  // A quantile cut gives the lower side floor(k/2) of the k tiles the points need, so that
+  // tiles come out nearly full rather than between half and all of the budget.
+  const double pieces = std::ceil(estimate / target);
+  const double lower_share = std::floor(pieces / 2) / pieces;
   const TileBox box = nodes_[node].box;  // a copy: nodes_ grows below
   std::array<int, 3> axes = {0, 1, 2};
   std::stable_sort(axes.begin(), axes.end(),
@@ -39,20 +54,28 @@ void TileTree::split_range(std::uint32_t node, const PointSample& sample, std::u
   for (const int axis : axes) {
     auto coord = [&](std::uint32_t i) { return sample.point(i)[axis]; };
     auto by_coord = [&](std::uint32_t i, std::uint32_t j) { return coord(i) < coord(j); };
-    std::uint32_t* middle = begin + (end - begin) / 2;
-    std::nth_element(begin, middle, end, by_coord);
-    double cut = coord(*middle);
-    const double lowest = coord(*std::min_element(begin, end, by_coord));
-    if (cut == lowest) {
-      // More than half the points share the lowest coordinate: cut just above them.
-      bool found = false;
-      for (const std::uint32_t* i = begin; i != end; ++i) {
-        if (coord(*i) > lowest && (!found || coord(*i) < cut)) {
-          cut = coord(*i);
-          found = true;
+    // The box's midpoint when it leaves each side at least 1/kMinShare of the points: compact
+    // tiles (fewer border points to exchange) that close in on dense regions.
+    double cut = 0.5 * (box.lo[axis] + box.hi[axis]);
+    const auto below = std::count_if(begin, end, [&](std::uint32_t i) { return coord(i) < cut; });
+    if (kMinShare * below < end - begin || kMinShare * below > (kMinShare - 1) * (end - begin)) {
+      // Otherwise the quantile, so that an uneven node still splits into nearly full tiles.
+      std::uint32_t* middle =
+          begin + static_cast<std::ptrdiff_t>(static_cast<double>(end - begin) * lower_share);
+      std::nth_element(begin, middle, end, by_coord);
+      cut = coord(*middle);
+      const double lowest = coord(*std::min_element(begin, end, by_coord));
+      if (cut == lowest) {
+        // The points below the cut share the lowest coordinate: cut just above them.
+        bool found = false;
+        for (const std::uint32_t* i = begin; i != end; ++i) {
+          if (coord(*i) > lowest && (!found || coord(*i) < cut)) {
+            cut = coord(*i);
+            found = true;
+          }
         }
+        if (!found) continue;  // all on one plane across this axis
       }
-      if (!found) continue;  // all on one plane across this axis
     }
     std::uint32_t* mid =
         std::partition(begin, end, [&](std::uint32_t i) { return coord(i) < cut; });

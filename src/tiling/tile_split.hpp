@@ -1,8 +1,11 @@
 // The adaptive split of the tile store (ALGORITHM.md §7.1, docs/tile-store.md "Adaptive
 // split"): a k-d tree over the cloud's bounding box whose leaves are the tiles. A leaf holding
-// too many points is cut across its longest axis at the median of a sample of its points, so
-// dense regions get small tiles and empty space costs nothing. The sample is a deterministic
-// hash of the points' global ids, so the tiles do not depend on chunking, threads or timing.
+// too many points is cut across its longest axis: at the box's midpoint when that leaves each
+// side at least 1/8 of its points (compact tiles, closing in on dense regions), else at a
+// quantile of a sample of its points (the median when it needs two tiles, k/2 of k when it
+// needs k, so tiles come out nearly full). Empty space costs nothing. The sample is a
+// deterministic hash of the points' global ids, so the tiles do not depend on chunking,
+// threads or timing.
 #pragma once
 
 #include <cstdint>
