@@ -49,14 +49,15 @@ ReadReport for_each_point(const std::filesystem::path& input, Visit&& visit) {
   return report;
 }
 
+[[noreturn]] void throw_changed(const std::filesystem::path& input) {
+  throw Error(Exit::bad_input,
+              fmt::format("{}: the file changed while it was being tiled", input.string()));
+}
+
 // A later pass must see the cloud the first one saw.
 void check_unchanged(const std::filesystem::path& input, const ReadReport& first,
                      const ReadReport& again) {
-  if (again.points != first.points || again.non_finite != first.non_finite) {
-    throw Error(Exit::bad_input,
-                fmt::format("{}: the file changed while it was being tiled ({} points, then {})",
-                            input.string(), first.points, again.points));
-  }
+  if (again.points != first.points || again.non_finite != first.non_finite) throw_changed(input);
 }
 
 // Exact point count of every leaf (indexed by node).
@@ -255,28 +256,38 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
   file.write(header.data(), header.size());
   file.write(table.data(), table.size());
 
-  BlockScratch scratch;
-  std::vector<double> xyz;
-  std::vector<Index> ids;
-  std::vector<std::uint64_t> start(tiles + 1, 0);  // a round's offsets of each tile's points
-  std::uint64_t written = 0;
+  // Rounds: runs of consecutive tiles holding at most round_points points (at least one tile).
+  // The point buffers are sized once for the largest, so they never reallocate (a copy would
+  // double the peak).
   const std::uint64_t round_points = std::max(options.round_points, options.tile_points);
-  for (std::size_t round_begin = 0; round_begin < tiles;) {
-    std::size_t round_end = round_begin;
-    std::uint64_t held = 0;
-    while (round_end < tiles &&
-           (round_end == round_begin || held + counts[leaves[round_end]] <= round_points)) {
-      start[round_end] = held;
-      held += counts[leaves[round_end++]];
+  std::vector<std::size_t> round_first = {0};
+  std::vector<std::uint64_t> start(tiles + 1, 0);  // each tile's offset in its round's buffers
+  std::uint64_t largest_round = 0;
+  for (std::size_t t = 0; t < tiles; ++t) {
+    const std::uint64_t held = start[t];
+    const std::uint64_t count = counts[leaves[t]];
+    if (held > 0 && held + count > round_points) {
+      round_first.push_back(t);
+      start[t] = 0;
     }
-    start[round_end] = held;
-    xyz.resize(held * 3);
-    ids.resize(held);
+    start[t + 1] = start[t] + count;
+    largest_round = std::max(largest_round, start[t + 1]);
+  }
+  round_first.push_back(tiles);
+
+  BlockScratch scratch;
+  std::vector<double> xyz(largest_round * 3);
+  std::vector<Index> ids(largest_round);
+  std::uint64_t written = 0;
+  for (std::size_t round = 0; round + 1 < round_first.size(); ++round) {
+    const std::size_t round_begin = round_first[round];
+    const std::size_t round_end = round_first[round + 1];
     std::vector<std::uint64_t> cursor(start.begin() + round_begin, start.begin() + round_end);
     const ReadReport again = for_each_point(input, [&](const double* p, std::uint64_t id) {
       const std::uint32_t t = tile_of_node[tree.leaf_of(p)];
       if (t < round_begin || t >= round_end) return;
       const std::uint64_t at = cursor[t - round_begin]++;
+      if (at - start[t] >= counts[leaves[t]]) throw_changed(input);  // before overrunning
       std::copy_n(p, 3, &xyz[3 * at]);
       ids[at] = static_cast<Index>(id);
     });
@@ -284,7 +295,7 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
     for (std::size_t t = round_begin; t < round_end; ++t) {
       const std::uint32_t node = leaves[t];
       const std::size_t begin = start[t];
-      const std::size_t n = start[t + 1] - begin;
+      const std::size_t n = counts[node];
       const std::span<const double> tile_xyz(xyz.data() + 3 * begin, 3 * n);
       const BlockEntry block =
           write_block(file, tile_xyz, std::span<const Index>(ids.data() + begin, n), tree.box(node),
@@ -302,7 +313,6 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
       written += n;
       if (options.progress) options.progress(written, total);
     }
-    round_begin = round_end;
   }
 
   unsigned char* h = header.data();
