@@ -13,6 +13,7 @@
 #include <cstring>
 #include <limits>
 #include <numeric>
+#include <utility>
 #include <vector>
 
 #include "g2s/error.hpp"
@@ -128,8 +129,7 @@ struct BlockEntry {
 
 // Scratch buffers reused for every block.
 struct BlockScratch {
-  std::vector<double> distance;
-  std::vector<std::uint32_t> order;
+  std::vector<std::pair<double, std::uint32_t>> order;
   std::vector<unsigned char> frame_table;
   std::vector<unsigned char> raw;
   std::vector<unsigned char> packed;
@@ -144,14 +144,13 @@ BlockEntry write_block(AtomicFile& file, std::span<const double> xyz, std::span<
                        BlockScratch& scratch) {
   const std::size_t n = ids.size();
   const BorderFaces faces(box, bounds);
-  scratch.distance.resize(n);
+  // (distance, local index) pairs: the points came in id order, so the index breaks ties as
+  // the id would, and the pairs sort without chasing pointers.
   scratch.order.resize(n);
-  for (std::size_t i = 0; i < n; ++i) scratch.distance[i] = faces.distance(&xyz[3 * i]);
-  std::iota(scratch.order.begin(), scratch.order.end(), 0u);
-  std::sort(scratch.order.begin(), scratch.order.end(), [&](std::uint32_t a, std::uint32_t b) {
-    const double da = scratch.distance[a], db = scratch.distance[b];
-    return da < db || (da == db && ids[a] < ids[b]);
-  });
+  for (std::size_t i = 0; i < n; ++i) {
+    scratch.order[i] = {faces.distance(&xyz[3 * i]), static_cast<std::uint32_t>(i)};
+  }
+  std::sort(scratch.order.begin(), scratch.order.end());
 
   const std::uint64_t frames = frame_count(n, kFramePoints);
   BlockEntry entry;
@@ -164,12 +163,12 @@ BlockEntry write_block(AtomicFile& file, std::span<const double> xyz, std::span<
     scratch.raw.resize(m * kPointBytes);
     unsigned char* out = scratch.raw.data();
     for (std::size_t k = 0; k < m; ++k) {
-      const double* p = &xyz[3 * scratch.order[first + k]];
+      const double* p = &xyz[3 * scratch.order[first + k].second];
       for (int a = 0; a < 3; ++a) store_le(out + (3 * k + a) * sizeof(double), p[a]);
     }
     out += 3 * m * sizeof(double);
     for (std::size_t k = 0; k < m; ++k) {
-      store_le(out + k * sizeof(std::uint32_t), ids[scratch.order[first + k]]);
+      store_le(out + k * sizeof(std::uint32_t), ids[scratch.order[first + k].second]);
     }
     const unsigned char* stored = scratch.raw.data();
     std::size_t stored_bytes = scratch.raw.size();
@@ -188,7 +187,7 @@ BlockEntry write_block(AtomicFile& file, std::span<const double> xyz, std::span<
     unsigned char* e = scratch.frame_table.data() + f * kFrameEntryBytes;
     store_le(e + frame::offset, file.size() - entry.offset);
     store_le(e + frame::stored_bytes, std::uint64_t{stored_bytes});
-    store_le(e + frame::first_distance, scratch.distance[scratch.order[first]]);
+    store_le(e + frame::first_distance, scratch.order[first].first);
     store_le(e + frame::checksum, xxhash64(stored, stored_bytes));
     file.write(stored, stored_bytes);
   }

@@ -1,13 +1,13 @@
-// Tile spacing estimate (see tile_spacing.hpp): the points are sorted by cell key once; a
-// sampled point's nearest neighbour is searched in shells of cells around its own, stopping
+// Tile spacing estimate (see tile_spacing.hpp): the points are bucketed by cell once; a sampled
+// point's nearest neighbour is searched in shells of cells around its own, stopping
 // once the best distance found is within the searched cube, so the answer is exact.
 #include "tiling/tile_spacing.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <utility>
 #include <vector>
 
 namespace g2s::tiling {
@@ -49,13 +49,29 @@ double estimate_tile_spacing(std::span<const double> xyz) {
                                     kMaxCells - 1);
   };
 
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> cells(n);
+  // Points bucketed by a hash of their cell (a counting sort, O(n)). Cells sharing a bucket
+  // only add candidates: distances are computed exactly, so the answer is unchanged.
+  std::size_t buckets = 64;
+  while (buckets < 2 * n) buckets *= 2;
+  const int bucket_shift = 64 - std::countr_zero(buckets);
+  auto bucket_of = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
+    return static_cast<std::size_t>((cell_key(x, y, z) * 0x9E3779B97F4A7C15ull) >> bucket_shift);
+  };
+  std::vector<std::uint32_t> bucket_start(buckets + 1, 0);
+  std::vector<std::uint32_t> point_bucket(n);
   for (std::size_t i = 0; i < n; ++i) {
     const double* p = &xyz[3 * i];
-    cells[i] = {cell_key(coord(p[0], 0), coord(p[1], 1), coord(p[2], 2)),
-                static_cast<std::uint32_t>(i)};
+    point_bucket[i] =
+        static_cast<std::uint32_t>(bucket_of(coord(p[0], 0), coord(p[1], 1), coord(p[2], 2)));
+    ++bucket_start[point_bucket[i] + 1];
   }
-  std::sort(cells.begin(), cells.end());
+  for (std::size_t b = 0; b < buckets; ++b) bucket_start[b + 1] += bucket_start[b];
+  std::vector<std::uint32_t> bucketed(n);
+  {
+    std::vector<std::uint32_t> fill(bucket_start.begin(), bucket_start.end() - 1);
+    for (std::size_t i = 0; i < n; ++i)
+      bucketed[fill[point_bucket[i]]++] = static_cast<std::uint32_t>(i);
+  }
 
   const std::size_t step = (n + kSamples - 1) / kSamples;
   double sum = 0.0;
@@ -75,11 +91,9 @@ double estimate_tile_spacing(std::span<const double> xyz) {
                 z >= kMaxCells) {
               continue;
             }
-            const std::uint64_t key = cell_key(x, y, z);
-            auto it = std::lower_bound(cells.begin(), cells.end(),
-                                       std::pair<std::uint64_t, std::uint32_t>{key, 0});
-            for (; it != cells.end() && it->first == key; ++it) {
-              const double* q = &xyz[3 * it->second];
+            const std::size_t b = bucket_of(x, y, z);
+            for (std::uint32_t k = bucket_start[b]; k < bucket_start[b + 1]; ++k) {
+              const double* q = &xyz[3 * bucketed[k]];
               const double d2 = (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
                                 (p[2] - q[2]) * (p[2] - q[2]);
               if (d2 > 0 && d2 < best2) best2 = d2;
