@@ -128,7 +128,7 @@ void add_tile_commands(CLI::App& app) {
                   "Most points in a tile (default 1048576); dense regions get smaller tiles")
       ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{0xFFFFFFFF}));
   cmd->add_flag("--compress", args->options.compress,
-                "zstd-compress the blocks (in 64k-point frames, so borders load without the rest)");
+                "zstd-compress the blocks (in 16k-point frames, so borders load without the rest)");
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
   cmd->add_flag("--json", args->json, "Print the summary as one JSON object on stdout");
   cmd->callback([args] { run_tile(*args); });

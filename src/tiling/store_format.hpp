@@ -20,7 +20,7 @@ inline constexpr char kMagic[8] = {'G', '2', 'S', 'T', 'I', 'L', 'E', 'S'};
 inline constexpr std::uint32_t kVersion = 1;
 inline constexpr std::uint32_t kFlagCompressed = 1;
 // Points per frame, the unit of compression and of checksums: load_border reads whole frames.
-inline constexpr std::uint32_t kFramePoints = 65536;
+inline constexpr std::uint32_t kFramePoints = 16384;
 // Bytes of a decoded point: x, y, z as double, then (in a separate run) the id as uint32.
 inline constexpr std::size_t kPointBytes = 3 * sizeof(double) + sizeof(std::uint32_t);
 

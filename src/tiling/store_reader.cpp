@@ -20,6 +20,21 @@ namespace g2s {
 
 using namespace tiling;
 
+namespace {
+
+// One decompression context per thread, reused across frames and loads (tiles are loaded from
+// several TBB tasks at once; a context must not be shared).
+ZSTD_DCtx* thread_decompressor() {
+  struct Holder {
+    ZSTD_DCtx* context = ZSTD_createDCtx();
+    ~Holder() { ZSTD_freeDCtx(context); }
+  };
+  thread_local Holder holder;
+  return holder.context;
+}
+
+}  // namespace
+
 struct TileStore::Impl {
   std::filesystem::path path;
   io::MappedFile file;
@@ -201,7 +216,8 @@ TilePoints TileStore::Impl::decode(std::size_t tile, const unsigned char* table,
     const unsigned char* raw = stored;
     if (compressed) {
       unpacked.resize(raw_bytes);
-      const std::size_t got = ZSTD_decompress(unpacked.data(), raw_bytes, stored, stored_bytes);
+      const std::size_t got = ZSTD_decompressDCtx(thread_decompressor(), unpacked.data(), raw_bytes,
+                                                  stored, stored_bytes);
       if (ZSTD_isError(got) || got != raw_bytes) {
         fail("tile {} frame {}: does not decompress to {} points ({})", tile, f, m,
              ZSTD_isError(got) ? ZSTD_getErrorName(got) : "wrong size");
