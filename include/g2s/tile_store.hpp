@@ -32,8 +32,10 @@ struct TileInfo {
 };
 
 struct TileStoreOptions {
-  std::uint64_t tile_points = std::uint64_t{1} << 20;  // no tile holds more (adaptive split)
-  bool compress = false;                               // zstd-compress the point blocks
+  // No tile holds more (adaptive split); the one exception is a tile of more than tile_points
+  // copies of a single point, which no plane can separate.
+  std::uint64_t tile_points = std::uint64_t{1} << 20;
+  bool compress = false;  // zstd-compress the point blocks
   int zstd_level = 1;
   // Points the writer holds in memory at once (28 bytes each; at least tile_points): the bound
   // on its memory. A larger cloud is written in several rounds of whole tiles, each re-reading

@@ -28,7 +28,7 @@ namespace {
 
 using namespace tiling;
 
-// Pass 1 holds up to twice this many sample points (36 bytes each: 19 MB); a cloud of at most
+// Pass 1 holds up to twice this many sample points (32 bytes each: 17 MB); a cloud of at most
 // twice as many points is sampled whole, so its tiles are exact without a counting pass.
 constexpr std::size_t kSampleTarget = std::size_t{1} << 18;
 // A tile split on a partial sample aims this far below the budget, so that the counting pass
