@@ -159,6 +159,12 @@ void TileStore::Impl::read_table(const unsigned char* table, std::uint64_t first
           "within {} bytes)",
           t, block_bytes[t], block_offset[t], next_block, end);
     }
+    const std::uint64_t raw_bytes =
+        frame_count(info.points, frame_points) * kFrameEntryBytes + info.points * kPointBytes;
+    if (!compressed && block_bytes[t] != raw_bytes) {
+      fail("tile {}: raw block of {} bytes for {} points (expected {})", t, block_bytes[t],
+           info.points, raw_bytes);
+    }
     next_block += block_bytes[t];
     points += info.points;
   }
