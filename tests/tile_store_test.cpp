@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <stdlib.h>
 #include <sys/wait.h>
+#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <zstd.h>
 
@@ -348,15 +349,21 @@ TEST_F(TileStoreTest, LoadBorderIsExactlyThePointsWithinTheDistance) {
   }
 }
 
-TEST_F(TileStoreTest, BytesAreDeterministicWhateverTheRounds) {
+TEST_F(TileStoreTest, BytesAreDeterministicWhateverTheRoundsAndThreads) {
   const fs::path input = synthetic("cube.ply", g2s::SynthShape::cube, 50'000);
   for (const bool compress : {false, true}) {
     const std::string once = read_bytes(build(input, "a.tiles", 3000, compress));
     const std::string again = read_bytes(build(input, "b.tiles", 3000, compress));
     // One tile per round: the input is re-read about 17 times, the bytes are the same.
     const std::string rounds = read_bytes(build(input, "c.tiles", 3000, compress, 1));
+    std::string one_thread;
+    {
+      const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+      one_thread = read_bytes(build(input, "d.tiles", 3000, compress));
+    }
     EXPECT_EQ(once, again);
     EXPECT_EQ(once, rounds);
+    EXPECT_EQ(once, one_thread);
   }
 }
 
@@ -432,6 +439,20 @@ TEST_F(TileStoreDamage, FlippedBlockBytes) {
                  {path.string() + ": ", "tile 2 frame 0: checksum mismatch"});
     // A border too thin to need any frame reads none.
     EXPECT_EQ(store.load_border(2, -1).size(), 0u);
+  }
+}
+
+TEST_F(TileStoreDamage, EveryByteIsCoveredByAChecksum) {
+  // Whichever byte is flipped, opening the store or loading its tiles reports it.
+  for (std::size_t offset = 0; offset < bytes_.size(); offset += 61) {
+    const fs::path path = damaged(flipped(offset));
+    try {
+      const g2s::TileStore store(path);
+      for (std::size_t t = 0; t < store.tiles().size(); ++t) store.load(t);
+      ADD_FAILURE() << "byte " << offset << " flipped unnoticed";
+    } catch (const g2s::Error& e) {
+      EXPECT_EQ(static_cast<int>(e.code()), static_cast<int>(Exit::bad_input)) << e.what();
+    }
   }
 }
 

@@ -129,8 +129,7 @@ PointCloud read_xyz_points(const MappedFile& file, ReadReport& report, const Poi
   // order. Collecting parses every chunk in one batch.
   constexpr std::size_t kChunk = 4u << 20;
   constexpr std::size_t kStreamBatch = 8;
-  std::vector<Chunk> chunks;
-  std::vector<Chunk> kept;  // collecting: every chunk's points, concatenated at the end
+  std::vector<Chunk> chunks;  // collecting: all of them, concatenated at the end
   std::uint64_t line = line_before;
   std::size_t pos = 0;
   const std::size_t text_start = file.size() - text.size();
@@ -154,31 +153,30 @@ PointCloud read_xyz_points(const MappedFile& file, ReadReport& report, const Poi
       tbb::parallel_for(std::size_t{0}, chunks.size(),
                         [&](std::size_t i) { parse_chunk(chunks[i]); });
     }
-    for (Chunk& c : chunks) {
+    for (const Chunk& c : chunks) {
       if (c.failed) fail_input(file.name(), "line {}: {}", line + c.lines, c.error);
       line += c.lines;
       report.non_finite += c.non_finite;
       report.points += c.xyz.size() / 3;
-      if (sink == nullptr) {
-        kept.push_back(std::move(c));
-      } else if (!c.xyz.empty()) {
-        (*sink)(c.xyz);
-      }
+      if (sink != nullptr && !c.xyz.empty()) (*sink)(c.xyz);
     }
     file.release_before(text_start + pos);
   }
 
   PointCloud cloud;
-  if (kept.size() == 1) {
-    cloud.xyz = std::move(kept[0].xyz);
-  } else if (kept.size() > 1) {
-    std::vector<std::size_t> offset(kept.size() + 1, 0);
-    for (std::size_t i = 0; i < kept.size(); ++i) offset[i + 1] = offset[i] + kept[i].xyz.size();
+  if (sink != nullptr) return cloud;
+  if (chunks.size() == 1) {
+    cloud.xyz = std::move(chunks[0].xyz);
+  } else if (chunks.size() > 1) {
+    std::vector<std::size_t> offset(chunks.size() + 1, 0);
+    for (std::size_t i = 0; i < chunks.size(); ++i) {
+      offset[i + 1] = offset[i] + chunks[i].xyz.size();
+    }
     cloud.xyz.resize(offset.back());
-    tbb::parallel_for(std::size_t{0}, kept.size(), [&](std::size_t i) {
-      std::memcpy(cloud.xyz.data() + offset[i], kept[i].xyz.data(),
-                  kept[i].xyz.size() * sizeof(double));
-      std::vector<double>().swap(kept[i].xyz);
+    tbb::parallel_for(std::size_t{0}, chunks.size(), [&](std::size_t i) {
+      std::memcpy(cloud.xyz.data() + offset[i], chunks[i].xyz.data(),
+                  chunks[i].xyz.size() * sizeof(double));
+      std::vector<double>().swap(chunks[i].xyz);
     });
   }
   return cloud;

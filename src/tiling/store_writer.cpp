@@ -3,9 +3,13 @@
 // split k-d style at sample medians (tile_split.hpp); when the sample did not hold every point,
 // counting passes check the tiles and re-split any over budget. Then the blocks are written in
 // rounds of consecutive tiles holding at most round_points points, each round re-reading the
-// input and keeping only its tiles' points. Everything is sequential in input order, so the
-// bytes do not depend on threads or timing.
+// input and keeping only its tiles' points. Points are taken in input order, sorted by a total
+// order, and frames encoded in parallel but written in order, so the bytes do not depend on
+// threads or timing.
 #include <fmt/core.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 #include <zstd.h>
 
 #include <algorithm>
@@ -126,18 +130,52 @@ struct BlockEntry {
   std::uint64_t frame_table_checksum = 0;
 };
 
+// What a thread needs to encode frames: the decoded bytes and a zstd context, reused.
+struct FrameEncoder {
+  std::vector<unsigned char> raw;
+  ZSTD_CCtx* zstd = ZSTD_createCCtx();
+  FrameEncoder() = default;
+  FrameEncoder(const FrameEncoder&) : FrameEncoder() {}  // copies start fresh (TBB's exemplar)
+  FrameEncoder& operator=(const FrameEncoder&) = delete;
+  ~FrameEncoder() { ZSTD_freeCCtx(zstd); }
+};
+
 // Scratch buffers reused for every block.
 struct BlockScratch {
   std::vector<std::pair<double, std::uint32_t>> order;
   std::vector<unsigned char> frame_table;
-  std::vector<unsigned char> raw;
-  std::vector<unsigned char> packed;
-  ZSTD_CCtx* zstd = nullptr;
-  ~BlockScratch() { ZSTD_freeCCtx(zstd); }
+  std::vector<std::vector<unsigned char>> frames;  // each frame's stored bytes
+  std::vector<std::size_t> zstd_results;           // each frame's zstd return code
+  tbb::enumerable_thread_specific<FrameEncoder> encoders;
 };
 
+// Encodes frame f of a block (points order[first, first + m)) into `stored`, compressed if
+// asked; returns zstd's result (an error code to check) or the raw size.
+std::size_t encode_frame(std::span<const double> xyz, std::span<const Index> ids,
+                         std::span<const std::pair<double, std::uint32_t>> order,
+                         const TileStoreOptions& options, FrameEncoder& encoder,
+                         std::vector<unsigned char>& stored) {
+  const std::size_t m = order.size();
+  std::vector<unsigned char>& raw = options.compress ? encoder.raw : stored;
+  raw.resize(m * kPointBytes);
+  unsigned char* out = raw.data();
+  for (std::size_t k = 0; k < m; ++k) {
+    const double* p = &xyz[3 * order[k].second];
+    for (int a = 0; a < 3; ++a) store_le(out + (3 * k + a) * sizeof(double), p[a]);
+  }
+  out += 3 * m * sizeof(double);
+  for (std::size_t k = 0; k < m; ++k) store_le(out + k * sizeof(Index), ids[order[k].second]);
+  if (!options.compress) return raw.size();
+  stored.resize(ZSTD_compressBound(raw.size()));
+  const std::size_t result = ZSTD_compressCCtx(encoder.zstd, stored.data(), stored.size(),
+                                               raw.data(), raw.size(), options.zstd_level);
+  stored.resize(ZSTD_isError(result) ? 0 : result);
+  return result;
+}
+
 // Writes one tile's block: its frame table, then its points ordered by border distance (ties
-// by id) in frames of kFramePoints, raw or zstd-compressed.
+// by id) in frames of kFramePoints, raw or zstd-compressed. The frames are encoded in parallel
+// into their own buffers and written in order, so the bytes do not depend on the threads.
 BlockEntry write_block(AtomicFile& file, std::span<const double> xyz, std::span<const Index> ids,
                        const TileBox& box, const TileBox& bounds, const TileStoreOptions& options,
                        BlockScratch& scratch) {
@@ -149,48 +187,39 @@ BlockEntry write_block(AtomicFile& file, std::span<const double> xyz, std::span<
   for (std::size_t i = 0; i < n; ++i) {
     scratch.order[i] = {faces.distance(&xyz[3 * i]), static_cast<std::uint32_t>(i)};
   }
-  std::sort(scratch.order.begin(), scratch.order.end());
+  tbb::parallel_sort(scratch.order.begin(), scratch.order.end());
 
-  const std::uint64_t frames = frame_count(n, kFramePoints);
+  const std::size_t frames = frame_count(n, kFramePoints);
+  scratch.frames.resize(std::max(scratch.frames.size(), frames));
+  scratch.zstd_results.resize(frames);
+  tbb::parallel_for(std::size_t{0}, frames, [&](std::size_t f) {
+    const std::size_t first = f * kFramePoints;
+    const std::size_t m = std::min<std::size_t>(kFramePoints, n - first);
+    scratch.zstd_results[f] = encode_frame(xyz, ids, std::span(scratch.order).subspan(first, m),
+                                           options, scratch.encoders.local(), scratch.frames[f]);
+  });
+
   BlockEntry entry;
   entry.offset = file.size();
   scratch.frame_table.assign(frames * kFrameEntryBytes, 0);
-  file.write(scratch.frame_table.data(), scratch.frame_table.size());
-  for (std::uint64_t f = 0; f < frames; ++f) {
-    const std::size_t first = f * kFramePoints;
-    const std::size_t m = std::min<std::size_t>(kFramePoints, n - first);
-    scratch.raw.resize(m * kPointBytes);
-    unsigned char* out = scratch.raw.data();
-    for (std::size_t k = 0; k < m; ++k) {
-      const double* p = &xyz[3 * scratch.order[first + k].second];
-      for (int a = 0; a < 3; ++a) store_le(out + (3 * k + a) * sizeof(double), p[a]);
+  std::uint64_t offset = scratch.frame_table.size();
+  for (std::size_t f = 0; f < frames; ++f) {
+    if (ZSTD_isError(scratch.zstd_results[f])) {
+      throw Error(Exit::failure,
+                  fmt::format("{}: zstd compression failed: {}", file.target().string(),
+                              ZSTD_getErrorName(scratch.zstd_results[f])));
     }
-    out += 3 * m * sizeof(double);
-    for (std::size_t k = 0; k < m; ++k) {
-      store_le(out + k * sizeof(std::uint32_t), ids[scratch.order[first + k].second]);
-    }
-    const unsigned char* stored = scratch.raw.data();
-    std::size_t stored_bytes = scratch.raw.size();
-    if (options.compress) {
-      if (scratch.zstd == nullptr) scratch.zstd = ZSTD_createCCtx();
-      scratch.packed.resize(ZSTD_compressBound(scratch.raw.size()));
-      stored_bytes = ZSTD_compressCCtx(scratch.zstd, scratch.packed.data(), scratch.packed.size(),
-                                       scratch.raw.data(), scratch.raw.size(), options.zstd_level);
-      if (ZSTD_isError(stored_bytes)) {
-        throw Error(Exit::failure,
-                    fmt::format("{}: zstd compression failed: {}", file.target().string(),
-                                ZSTD_getErrorName(stored_bytes)));
-      }
-      stored = scratch.packed.data();
-    }
+    const std::vector<unsigned char>& stored = scratch.frames[f];
     unsigned char* e = scratch.frame_table.data() + f * kFrameEntryBytes;
-    store_le(e + frame::offset, file.size() - entry.offset);
-    store_le(e + frame::stored_bytes, std::uint64_t{stored_bytes});
-    store_le(e + frame::first_distance, scratch.order[first].first);
-    store_le(e + frame::checksum, xxhash64(stored, stored_bytes));
-    file.write(stored, stored_bytes);
+    store_le(e + frame::offset, offset);
+    store_le(e + frame::stored_bytes, std::uint64_t{stored.size()});
+    store_le(e + frame::first_distance, scratch.order[f * kFramePoints].first);
+    store_le(e + frame::checksum, xxhash64(stored.data(), stored.size()));
+    offset += stored.size();
   }
-  file.write_at(entry.offset, scratch.frame_table.data(), scratch.frame_table.size());
+  file.write(scratch.frame_table.data(), scratch.frame_table.size());
+  for (std::size_t f = 0; f < frames; ++f)
+    file.write(scratch.frames[f].data(), scratch.frames[f].size());
   entry.bytes = file.size() - entry.offset;
   entry.frame_table_checksum = xxhash64(scratch.frame_table.data(), scratch.frame_table.size());
   return entry;
