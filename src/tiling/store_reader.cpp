@@ -1,6 +1,7 @@
-// TileStore (docs/tile-store.md "Reading"): maps the store, validates the header and the tile
-// table once, then loads a tile's frames on demand, checking each frame's checksum as it is
-// read. Nothing is modified after opening, so loads from several threads need no locking.
+// TileStore (docs/tile-store.md "Loading a tile and its halo"): maps the store, validates the
+// header and the tile table once, then loads a tile's frames on demand, checking each frame's
+// checksum as it is read. Nothing is modified after opening, so loads from several threads need no
+// locking.
 #include <fmt/core.h>
 #include <zstd.h>
 

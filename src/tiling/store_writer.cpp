@@ -1,11 +1,11 @@
 // build_tile_store (ALGORITHM.md §7.1, docs/tile-store.md): tiles a cloud in streaming passes
 // with bounded memory. Pass 1 finds the bounding box and a deterministic sample; the box is
-// split k-d style at sample medians (tile_split.hpp); when the sample did not hold every point,
-// counting passes check the tiles and re-split any over budget. Then the blocks are written in
-// rounds of consecutive tiles holding at most round_points points, each round re-reading the
-// input and keeping only its tiles' points. Points are taken in input order, sorted by a total
-// order, and frames encoded in parallel but written in order, so the bytes do not depend on
-// threads or timing.
+// split k-d style at box midpoints or sample quantiles (tile_split.hpp); when the sample did
+// not hold every point, counting passes check the tiles and re-split any over budget. Then the
+// blocks are written in rounds of consecutive tiles holding at most round_points points, each
+// round re-reading the input and keeping only its tiles' points. Points are taken in input
+// order, sorted by a total order, and frames encoded in parallel but written in order, so the
+// bytes do not depend on threads or timing.
 #include <fmt/core.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -149,8 +149,8 @@ struct BlockScratch {
   tbb::enumerable_thread_specific<FrameEncoder> encoders;
 };
 
-// Encodes frame f of a block (points order[first, first + m)) into `stored`, compressed if
-// asked; returns zstd's result (an error code to check) or the raw size.
+// Encodes one frame, the points `order` picks, into `stored` (compressed if asked); returns
+// zstd's result (an error code to check) or the raw size.
 std::size_t encode_frame(std::span<const double> xyz, std::span<const Index> ids,
                          std::span<const std::pair<double, std::uint32_t>> order,
                          const TileStoreOptions& options, FrameEncoder& encoder,

@@ -42,7 +42,7 @@ bool TileTree::split(std::uint32_t node, const PointSample& sample, double weigh
 void TileTree::split_range(std::uint32_t node, const PointSample& sample, std::uint32_t* begin,
                            std::uint32_t* end, double weight, double target) {
   const double estimate = static_cast<double>(end - begin) * weight;
-  if (estimate <= target) return;
+  if (end - begin < 2 || estimate <= target) return;  // one point cannot be split
   // A quantile cut gives the lower side floor(k/2) of the k tiles the points need, so that
   // tiles come out nearly full rather than between half and all of the budget.
   const double pieces = std::ceil(estimate / target);
