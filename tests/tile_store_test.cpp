@@ -319,6 +319,22 @@ TEST_F(TileStoreTest, DenseClusterGetsSmallerTiles) {
   EXPECT_LT(median(cluster_volumes) * 100, median(spread_volumes));
 }
 
+TEST_F(TileStoreTest, PointsOnTheOuterFacesGiveNoFlatTiles) {
+  // The cube's points lie exactly on its faces: many share the largest coordinate. A tile cut
+  // there would be a flat slab on the cloud's face, which its neighbour's border would miss.
+  const fs::path input = synthetic("cube.ply", g2s::SynthShape::cube, 50'000);
+  for (const std::uint64_t budget : {500u, 3000u, 9000u}) {
+    const g2s::TileStore store(build(input, "cube.tiles", budget, false));
+    expect_partition(store, g2s::read_points(input), budget);
+    for (std::size_t t = 0; t < store.tiles().size(); ++t) {
+      const g2s::TileBox& b = store.tiles()[t].box;
+      for (int a = 0; a < 3; ++a) {
+        EXPECT_LT(b.lo[a], b.hi[a]) << "tile " << t << " is flat on axis " << a;
+      }
+    }
+  }
+}
+
 TEST_F(TileStoreTest, LoadBorderIsExactlyThePointsWithinTheDistance) {
   // Tiles of about 100k points, several frames each, so frame selection is exercised too.
   const fs::path input = synthetic("torus.ply", g2s::SynthShape::torus, 400'000);

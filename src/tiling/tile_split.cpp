@@ -76,6 +76,17 @@ void TileTree::split_range(std::uint32_t node, const PointSample& sample, std::u
         }
         if (!found) continue;  // all on one plane across this axis
       }
+      if (cut == box.hi[axis]) {
+        // Many points lie on the box's upper face, which is the cloud's: cutting there would
+        // leave a flat tile on the cloud's face, a neighbour that the face rules out of the
+        // lower tile's border. Cut halfway below them instead.
+        double next_lower = lowest;
+        for (const std::uint32_t* i = begin; i != end; ++i) {
+          if (coord(*i) < cut) next_lower = std::max(next_lower, coord(*i));
+        }
+        const double halfway = 0.5 * (next_lower + cut);
+        if (next_lower < halfway && halfway < cut) cut = halfway;
+      }
     }
     std::uint32_t* mid =
         std::partition(begin, end, [&](std::uint32_t i) { return coord(i) < cut; });
