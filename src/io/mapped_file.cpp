@@ -78,6 +78,14 @@ void MappedFile::release_before(std::size_t offset) const {
   released_ = end;
 }
 
+void MappedFile::release(std::size_t begin, std::size_t end) const {
+  if (mode_ != MapMode::stream || map_ == nullptr) return;
+  const std::size_t page = static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
+  const std::size_t first = (begin + page - 1) / page * page;
+  const std::size_t last = std::min(end, size_) / page * page;
+  if (first < last) ::madvise(static_cast<char*>(map_) + first, last - first, MADV_DONTNEED);
+}
+
 MappedFile::~MappedFile() {
   if (map_ != nullptr) ::munmap(map_, size_);
 }

@@ -33,6 +33,9 @@ class MappedFile {
   // process's resident set (they stay in the page cache). Const because the view is unchanged:
   // a page touched again is read back in. A no-op in whole mode.
   void release_before(std::size_t offset) const;
+  // Stream mode: the whole pages inside [begin, end) leave the resident set (for random access,
+  // e.g. a tile store's blocks; safe while other threads read them: they are read back in).
+  void release(std::size_t begin, std::size_t end) const;
 
  private:
   std::string name_;

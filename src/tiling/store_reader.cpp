@@ -240,6 +240,9 @@ TilePoints TileStore::Impl::decode(std::size_t tile, const unsigned char* table,
     Index* id = out.ids.data() + first;
     for (std::size_t k = 0; k < m; ++k) id[k] = load_le<std::uint32_t>(ids + k * sizeof(Index));
   }
+  // The decoded copy is the caller's: the mapped pages need not stay resident (a pipeline
+  // loads every tile once; its memory should not grow to the size of the store).
+  file.release(block_offset[tile], block_offset[tile] + expected_offset);
   if (frames == all_frames && expected_offset != block_bytes[tile]) {
     fail("tile {}: the frames end at byte {} of a {}-byte block (corrupt block)", tile,
          expected_offset, block_bytes[tile]);
