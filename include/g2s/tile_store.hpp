@@ -32,9 +32,17 @@ struct TileInfo {
 };
 
 struct TileStoreOptions {
-  std::uint64_t tile_points = std::uint64_t{1} << 20;  // no tile holds more (adaptive split)
-  bool compress = false;                               // zstd-compress the point blocks
+  // No tile holds more (adaptive split); the one exception is a tile of more than tile_points
+  // copies of a single point, which no plane can separate.
+  std::uint64_t tile_points = std::uint64_t{1} << 20;
+  bool compress = false;  // zstd-compress the point blocks
   int zstd_level = 1;
+  // Points the writer holds in memory at once (28 bytes each; at least tile_points): the bound
+  // on its memory. A larger cloud is written in several rounds of whole tiles, each re-reading
+  // the input. Added with the implementation: the memory bound is the caller's to choose, and
+  // the tests need several rounds without a 100M-point file. The bytes written do not depend
+  // on it.
+  std::uint64_t round_points = std::uint64_t{8} << 20;
   // Called now and then with (points done, points in total) while writing; may be empty.
   std::function<void(std::uint64_t, std::uint64_t)> progress;
 };
@@ -77,6 +85,7 @@ class TileStore {
   const TileBox& bounds() const;      // bounding box of all points
   std::span<const TileInfo> tiles() const;
   const ReadReport& input_report() const;  // as build_tile_store saw the input
+  bool compressed() const;                 // blocks are zstd frames (for g2s tile-info)
 
   // All points of a tile.
   TilePoints load(std::size_t tile) const;

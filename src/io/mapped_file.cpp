@@ -9,6 +9,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
@@ -30,7 +31,8 @@ struct FdGuard {
 
 }  // namespace
 
-MappedFile::MappedFile(const std::filesystem::path& path) : name_(path.string()) {
+MappedFile::MappedFile(const std::filesystem::path& path, MapMode mode)
+    : name_(path.string()), mode_(mode) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) fail_errno(name_, "cannot open", errno);
   FdGuard guard{fd};
@@ -41,7 +43,8 @@ MappedFile::MappedFile(const std::filesystem::path& path) : name_(path.string())
   }
   if (S_ISREG(st.st_mode) && st.st_size > 0) {
     size_ = static_cast<std::size_t>(st.st_size);
-    void* map = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+    const int populate = mode == MapMode::whole ? MAP_POPULATE : 0;
+    void* map = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | populate, fd, 0);
     if (map == MAP_FAILED) fail_errno(name_, "cannot map", errno);
     ::madvise(map, size_, MADV_SEQUENTIAL);
     map_ = map;
@@ -64,6 +67,23 @@ MappedFile::MappedFile(const std::filesystem::path& path) : name_(path.string())
   copy_.resize(used);
   data_ = copy_.data();
   size_ = used;
+}
+
+void MappedFile::release_before(std::size_t offset) const {
+  if (mode_ != MapMode::stream || map_ == nullptr) return;
+  const std::size_t page = static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
+  const std::size_t end = std::min(offset, size_) / page * page;
+  if (end <= released_) return;
+  ::madvise(static_cast<char*>(map_) + released_, end - released_, MADV_DONTNEED);
+  released_ = end;
+}
+
+void MappedFile::release(std::size_t begin, std::size_t end) const {
+  if (mode_ != MapMode::stream || map_ == nullptr) return;
+  const std::size_t page = static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
+  const std::size_t first = (begin + page - 1) / page * page;
+  const std::size_t last = std::min(end, size_) / page * page;
+  if (first < last) ::madvise(static_cast<char*>(map_) + first, last - first, MADV_DONTNEED);
 }
 
 MappedFile::~MappedFile() {

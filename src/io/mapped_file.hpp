@@ -1,6 +1,8 @@
 // Read-only view of a whole input file for the readers: mmap for regular files (no copy, the
 // page cache does the work), a read() loop for pipes and /proc-like files. Opening problems
-// (missing, directory, permission) throw Error(bad_input) naming the file.
+// (missing, directory, permission) throw Error(bad_input) naming the file. A streaming reader
+// maps lazily and releases the pages it has consumed, so resident memory stays at a window
+// however large the file.
 #pragma once
 
 #include <cstddef>
@@ -11,9 +13,13 @@
 
 namespace g2s::io {
 
+// whole: every page is read in at once (fastest when the caller keeps the whole cloud anyway).
+// stream: pages are read in as touched, and release_before() drops the consumed ones.
+enum class MapMode { whole, stream };
+
 class MappedFile {
  public:
-  explicit MappedFile(const std::filesystem::path& path);
+  explicit MappedFile(const std::filesystem::path& path, MapMode mode = MapMode::whole);
   ~MappedFile();
   MappedFile(const MappedFile&) = delete;
   MappedFile& operator=(const MappedFile&) = delete;
@@ -23,11 +29,21 @@ class MappedFile {
   std::size_t size() const { return size_; }
   const std::string& name() const { return name_; }  // the path as given, for messages
 
+  // Stream mode: the bytes before `offset` will not be read again; their pages leave this
+  // process's resident set (they stay in the page cache). Const because the view is unchanged:
+  // a page touched again is read back in. A no-op in whole mode.
+  void release_before(std::size_t offset) const;
+  // Stream mode: the whole pages inside [begin, end) leave the resident set (for random access,
+  // e.g. a tile store's blocks; safe while other threads read them: they are read back in).
+  void release(std::size_t begin, std::size_t end) const;
+
  private:
   std::string name_;
   const char* data_ = nullptr;
   std::size_t size_ = 0;
   void* map_ = nullptr;  // non-null when data_ is an mmap
+  MapMode mode_;
+  mutable std::size_t released_ = 0;  // page-aligned: bytes already released
   std::vector<char> copy_;
 };
 

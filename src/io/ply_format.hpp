@@ -11,6 +11,7 @@
 
 #include "g2s/types.hpp"
 #include "io/mapped_file.hpp"
+#include "io/readers.hpp"
 
 namespace g2s::io {
 
@@ -77,11 +78,15 @@ const char* ply_format_name(PlyEncoding encoding);
 struct PlyBodyRequest {
   bool drop_non_finite = true;             // points: drop and count NaN/Inf vertices
   std::vector<Triangle>* faces = nullptr;  // meshes: the face element, fanned into triangles
+  // Streaming: the vertices go to this sink, at most kScanChunkPoints at a time, instead of
+  // into the result, and the pages read are released as the body is consumed.
+  const PointSink* points = nullptr;
 };
 
 struct PlyBodyResult {
-  std::vector<double> xyz;
+  std::vector<double> xyz;  // empty when streamed to a sink
   std::uint64_t non_finite = 0;
+  std::uint64_t streamed = 0;  // points handed to the sink
 };
 
 // Walks the body of every element in header order (other elements and properties skipped,

@@ -1,7 +1,8 @@
 // PLY body reader shared by read_points and read_mesh: walks every element of an ascii or
 // binary (LE/BE) body in header order, takes the vertex element's x, y, z (any scalar type, any
 // position, lists allowed around them) and optionally the face index lists, skips the rest.
-// Binary vertices without lists take a fixed-stride loop specialised for float/double.
+// Binary vertices without lists take a fixed-stride loop specialised for float/double. Vertices
+// are collected (read_points) or streamed to a sink in runs (scan_points, bounded memory).
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -286,9 +287,46 @@ class BodyReader {
     return kept;
   }
 
+  // Converts `count` fixed-size rows into out; returns the points kept.
+  std::size_t convert_rows(const unsigned char* base, std::size_t stride, std::uint64_t count,
+                           const std::size_t off[3], const PlyType type[3], double* out) {
+    const bool same = type[0] == type[1] && type[1] == type[2];
+    if (same && type[0] == PlyType::f32) {
+      return swap_ ? convert_fixed<float, true>(base, stride, count, off, out)
+                   : convert_fixed<float, false>(base, stride, count, off, out);
+    }
+    if (same && type[0] == PlyType::f64) {
+      return swap_ ? convert_fixed<double, true>(base, stride, count, off, out)
+                   : convert_fixed<double, false>(base, stride, count, off, out);
+    }
+    std::size_t kept = 0;
+    for (std::uint64_t r = 0; r < count; ++r) {
+      const unsigned char* row = base + r * stride;
+      double* o = out + 3 * kept;
+      for (int a = 0; a < 3; ++a) o[a] = load_double(row + off[a], type[a], swap_);
+      if (request_.drop_non_finite && !all_finite(o)) {
+        ++result_.non_finite;
+      } else {
+        ++kept;
+      }
+    }
+    return kept;
+  }
+
+  // Streaming: hands the points collected so far to the sink and releases the file's pages
+  // before `consumed`. Collecting: nothing to do.
+  void emit(std::size_t consumed) {
+    if (request_.points == nullptr) return;
+    if (!result_.xyz.empty()) (*request_.points)(result_.xyz);
+    result_.streamed += result_.xyz.size() / 3;
+    result_.xyz.clear();
+    file_.release_before(consumed);
+  }
+
   std::size_t binary_vertices(const PlyElement& e, std::size_t pos) {
     std::vector<double>& xyz = result_.xyz;
     const bool drop = request_.drop_non_finite;
+    const bool streaming = request_.points != nullptr;
     if (!e.has_lists()) {
       const std::size_t end = fixed_rows_end(e, pos);
       std::size_t off[3] = {0, 0, 0};
@@ -298,33 +336,22 @@ class BodyReader {
         type[a] = e.properties[vertex_.xyz[a]].type;
       }
       const std::size_t stride = e.fixed_row_size();
-      xyz.resize(static_cast<std::size_t>(e.count) * 3);
-      const unsigned char* base = data_ + pos;
-      std::size_t kept = 0;
-      const bool same = type[0] == type[1] && type[1] == type[2];
-      if (same && type[0] == PlyType::f32) {
-        kept = swap_ ? convert_fixed<float, true>(base, stride, e.count, off, xyz.data())
-                     : convert_fixed<float, false>(base, stride, e.count, off, xyz.data());
-      } else if (same && type[0] == PlyType::f64) {
-        kept = swap_ ? convert_fixed<double, true>(base, stride, e.count, off, xyz.data())
-                     : convert_fixed<double, false>(base, stride, e.count, off, xyz.data());
-      } else {
-        for (std::uint64_t r = 0; r < e.count; ++r) {
-          const unsigned char* row = base + r * stride;
-          double* o = xyz.data() + 3 * kept;
-          for (int a = 0; a < 3; ++a) o[a] = load_double(row + off[a], type[a], swap_);
-          if (drop && !all_finite(o)) {
-            ++result_.non_finite;
-          } else {
-            ++kept;
-          }
-        }
+      // Collecting converts the element in one run; streaming in runs of kScanChunkPoints.
+      const std::uint64_t run = streaming ? kScanChunkPoints : std::max<std::uint64_t>(e.count, 1);
+      for (std::uint64_t first = 0; first < e.count; first += run) {
+        const std::uint64_t rows = std::min(run, e.count - first);
+        xyz.resize(static_cast<std::size_t>(rows) * 3);
+        const std::size_t kept =
+            convert_rows(data_ + pos + first * stride, stride, rows, off, type, xyz.data());
+        xyz.resize(kept * 3);
+        emit(pos + static_cast<std::size_t>((first + rows) * stride));
       }
-      xyz.resize(kept * 3);
       return end;
     }
     std::vector<std::size_t> offsets(e.properties.size());
-    xyz.reserve(static_cast<std::size_t>(std::min<std::uint64_t>(e.count, (size_ - pos) / 3)) * 3);
+    std::uint64_t reserve = std::min<std::uint64_t>(e.count, (size_ - pos) / 3);
+    if (streaming) reserve = std::min<std::uint64_t>(reserve, kScanChunkPoints);
+    xyz.reserve(static_cast<std::size_t>(reserve) * 3);
     for (std::uint64_t r = 0; r < e.count; ++r) {
       pos = binary_row(e, pos, r, offsets.data());
       double o[3];
@@ -337,7 +364,9 @@ class BodyReader {
         continue;
       }
       xyz.insert(xyz.end(), o, o + 3);
+      if (streaming && xyz.size() == 3 * kScanChunkPoints) emit(pos);
     }
+    emit(pos);
     return pos;
   }
 
@@ -419,7 +448,10 @@ class BodyReader {
   void ascii_vertices(LineCursor& lines, const PlyElement& e) {
     std::vector<double>& xyz = result_.xyz;
     const bool drop = request_.drop_non_finite;
-    xyz.reserve(static_cast<std::size_t>(std::min<std::uint64_t>(e.count, size_ / 6)) * 3);
+    const bool streaming = request_.points != nullptr;
+    std::uint64_t reserve = std::min<std::uint64_t>(e.count, size_ / 6);
+    if (streaming) reserve = std::min<std::uint64_t>(reserve, kScanChunkPoints);
+    xyz.reserve(static_cast<std::size_t>(reserve) * 3);
     std::vector<std::string_view> tokens;
     std::vector<std::size_t> where(e.properties.size());
     for (std::size_t i = 0; i < where.size(); ++i) where[i] = i;
@@ -448,7 +480,9 @@ class BodyReader {
         continue;
       }
       xyz.insert(xyz.end(), o, o + 3);
+      if (streaming && xyz.size() == 3 * kScanChunkPoints) emit(lines.position());
     }
+    emit(lines.position());
   }
 
   void ascii_faces(LineCursor& lines, const PlyElement& e) {

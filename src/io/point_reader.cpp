@@ -1,5 +1,7 @@
-// read_points: opens the file once, sniffs the content (the "ply" magic line, else text; binary
-// bytes in a non-PLY file are an error) and hands it to the PLY or the XYZ reader. The CLI
+// read_points and scan_points: open the file once, sniff the content (the "ply" magic line, else
+// text; binary bytes in a non-PLY file are an error) and hand it to the PLY or the XYZ reader,
+// which either collects the points (read_points) or streams them to a sink in bounded memory
+// (scan_points, for the tile store). One path, so both number and reject points alike. The CLI
 // decides what an empty cloud means; at this layer zero points is a valid answer.
 #include <string_view>
 
@@ -10,12 +12,13 @@
 #include "io/text_util.hpp"
 
 namespace g2s {
+namespace {
 
-PointCloud read_points(const std::filesystem::path& path, ReadReport* report) {
-  ReadReport local;
-  ReadReport& r = report != nullptr ? *report : local;
+// Reads `path` into the returned cloud (sink == nullptr) or streams it to the sink.
+PointCloud read_or_scan(const std::filesystem::path& path, const io::PointSink* sink,
+                        ReadReport& r) {
   r = ReadReport{};
-  const io::MappedFile file(path);
+  const io::MappedFile file(path, sink == nullptr ? io::MapMode::whole : io::MapMode::stream);
   if (file.size() == 0) {
     io::fail_input(file.name(), "file is empty (expected a PLY or XYZ/PTS point cloud)");
   }
@@ -25,10 +28,12 @@ PointCloud read_points(const std::filesystem::path& path, ReadReport* report) {
     r.declared = header.elements.empty() || header.find("vertex") < 0
                      ? 0
                      : header.elements[static_cast<std::size_t>(header.find("vertex"))].count;
-    io::PlyBodyResult body = io::read_ply_body(file, header, io::PlyBodyRequest{});
+    io::PlyBodyRequest request;
+    request.points = sink;
+    io::PlyBodyResult body = io::read_ply_body(file, header, request);
     PointCloud cloud;
     cloud.xyz = std::move(body.xyz);
-    r.points = cloud.size();
+    r.points = cloud.size() + body.streamed;
     r.non_finite = body.non_finite;
     return cloud;
   }
@@ -44,7 +49,21 @@ PointCloud read_points(const std::filesystem::path& path, ReadReport* report) {
                      i, c);
     }
   }
-  return io::read_xyz_points(file, r);
+  return io::read_xyz_points(file, r, sink);
 }
 
+}  // namespace
+
+PointCloud read_points(const std::filesystem::path& path, ReadReport* report) {
+  ReadReport local;
+  return read_or_scan(path, nullptr, report != nullptr ? *report : local);
+}
+
+namespace io {
+
+void scan_points(const std::filesystem::path& path, const PointSink& sink, ReadReport& report) {
+  read_or_scan(path, &sink, report);
+}
+
+}  // namespace io
 }  // namespace g2s

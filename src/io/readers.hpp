@@ -2,14 +2,33 @@
 // an already opened MappedFile so the format can be sniffed once from its content.
 #pragma once
 
+#include <cstddef>
+#include <functional>
+#include <span>
+
 #include "g2s/io.hpp"
 #include "g2s/types.hpp"
 #include "io/mapped_file.hpp"
 
 namespace g2s::io {
 
-// Text XYZ/PTS/CSV points (xyz_reader.cpp). Fills report->format/points/non_finite.
-PointCloud read_xyz_points(const MappedFile& file, ReadReport& report);
+// Receives the finite points of a cloud in file order, a run at a time (3 doubles per point);
+// the span is valid during the call only.
+using PointSink = std::function<void(std::span<const double> xyz)>;
+
+// Largest run a streaming PLY reader hands to a PointSink (24 MB of doubles).
+inline constexpr std::size_t kScanChunkPoints = std::size_t{1} << 20;
+
+// Streams the points of a cloud (any format read_points reads, same checks, same messages,
+// same numbering) to `sink` in bounded memory: the file is mapped lazily and consumed pages are
+// released, so the resident set holds a window of the file and one run of points. This is the
+// one reading path: read_points collects what it streams. Fills `report` as read_points does.
+// Throws Error(bad_input) like read_points; runs already handed to the sink stay handed.
+void scan_points(const std::filesystem::path& path, const PointSink& sink, ReadReport& report);
+
+// Text XYZ/PTS/CSV points (xyz_reader.cpp). Fills report->format/points/non_finite. With a
+// sink, the points go to it in order and the result is empty; without one, they are returned.
+PointCloud read_xyz_points(const MappedFile& file, ReadReport& report, const PointSink* sink);
 
 // Binary or ASCII STL, welded (stl_reader.cpp); throws Error(bad_input) if it is neither.
 IndexedMesh read_stl(const MappedFile& file);

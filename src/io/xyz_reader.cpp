@@ -1,6 +1,8 @@
 // Text point reader (XYZ, PTS, TXT, CSV): one point per line, space/tab/comma separated, extra
 // columns ignored, '#' and '//' comments and blank lines skipped, a leading PTS count line or a
-// CSV column-name line skipped. Large files are cut at line ends and parsed in parallel (TBB).
+// CSV column-name line skipped. Large files are cut at line ends and parsed in parallel (TBB):
+// all at once when collecting, a batch of chunks at a time when streaming to a sink (so memory
+// holds one batch whatever the file size).
 #include <tbb/parallel_for.h>
 
 #include <cmath>
@@ -90,7 +92,7 @@ void parse_chunk(Chunk& chunk) {
 
 }  // namespace
 
-PointCloud read_xyz_points(const MappedFile& file, ReadReport& report) {
+PointCloud read_xyz_points(const MappedFile& file, ReadReport& report, const PointSink* sink) {
   report.format = "xyz";
   report.declared = 0;
   std::string_view text = file.view();
@@ -123,53 +125,60 @@ PointCloud read_xyz_points(const MappedFile& file, ReadReport& report) {
     }
   }
 
-  // Cut into chunks at line ends.
+  // Cut into chunks at line ends; parse a batch of them in parallel, then take their points in
+  // order. Collecting parses every chunk in one batch.
   constexpr std::size_t kChunk = 4u << 20;
-  std::vector<Chunk> chunks;
+  constexpr std::size_t kStreamBatch = 8;
+  std::vector<Chunk> chunks;  // collecting: all of them, concatenated at the end
+  std::uint64_t line = line_before;
   std::size_t pos = 0;
+  const std::size_t text_start = file.size() - text.size();
   while (pos < text.size()) {
-    std::size_t cut = std::min(text.size(), pos + kChunk);
-    if (cut < text.size()) {
-      const void* nl = std::memchr(text.data() + cut, '\n', text.size() - cut);
-      cut = nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - text.data()) + 1
-               : text.size();
+    chunks.clear();
+    while (pos < text.size() && (sink == nullptr || chunks.size() < kStreamBatch)) {
+      std::size_t cut = std::min(text.size(), pos + kChunk);
+      if (cut < text.size()) {
+        const void* nl = std::memchr(text.data() + cut, '\n', text.size() - cut);
+        cut = nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - text.data()) + 1
+                 : text.size();
+      }
+      Chunk c;
+      c.text = text.substr(pos, cut - pos);
+      chunks.push_back(std::move(c));
+      pos = cut;
     }
-    Chunk c;
-    c.text = text.substr(pos, cut - pos);
-    chunks.push_back(std::move(c));
-    pos = cut;
-  }
-  if (chunks.size() == 1) {
-    parse_chunk(chunks[0]);
-  } else {
-    tbb::parallel_for(std::size_t{0}, chunks.size(),
-                      [&](std::size_t i) { parse_chunk(chunks[i]); });
+    if (chunks.size() == 1) {
+      parse_chunk(chunks[0]);
+    } else {
+      tbb::parallel_for(std::size_t{0}, chunks.size(),
+                        [&](std::size_t i) { parse_chunk(chunks[i]); });
+    }
+    for (const Chunk& c : chunks) {
+      if (c.failed) fail_input(file.name(), "line {}: {}", line + c.lines, c.error);
+      line += c.lines;
+      report.non_finite += c.non_finite;
+      report.points += c.xyz.size() / 3;
+      if (sink != nullptr && !c.xyz.empty()) (*sink)(c.xyz);
+    }
+    file.release_before(text_start + pos);
   }
 
-  std::size_t total = 0;
-  std::uint64_t line = line_before;
-  for (const Chunk& c : chunks) {
-    if (c.failed) fail_input(file.name(), "line {}: {}", line + c.lines, c.error);
-    line += c.lines;
-    total += c.xyz.size();
-    report.non_finite += c.non_finite;
-  }
   PointCloud cloud;
+  if (sink != nullptr) return cloud;
   if (chunks.size() == 1) {
     cloud.xyz = std::move(chunks[0].xyz);
-  } else {
-    cloud.xyz.resize(total);
-    std::vector<std::size_t> offset(chunks.size(), 0);
-    for (std::size_t i = 1; i < chunks.size(); ++i) {
-      offset[i] = offset[i - 1] + chunks[i - 1].xyz.size();
+  } else if (chunks.size() > 1) {
+    std::vector<std::size_t> offset(chunks.size() + 1, 0);
+    for (std::size_t i = 0; i < chunks.size(); ++i) {
+      offset[i + 1] = offset[i] + chunks[i].xyz.size();
     }
+    cloud.xyz.resize(offset.back());
     tbb::parallel_for(std::size_t{0}, chunks.size(), [&](std::size_t i) {
       std::memcpy(cloud.xyz.data() + offset[i], chunks[i].xyz.data(),
                   chunks[i].xyz.size() * sizeof(double));
       std::vector<double>().swap(chunks[i].xyz);
     });
   }
-  report.points = cloud.size();
   return cloud;
 }
 

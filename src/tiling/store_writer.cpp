@@ -1,0 +1,377 @@
+// build_tile_store (ALGORITHM.md §7.1, docs/tile-store.md): tiles a cloud in streaming passes
+// with bounded memory. Pass 1 finds the bounding box and a deterministic sample; the box is
+// split k-d style at box midpoints or sample quantiles (tile_split.hpp); when the sample did
+// not hold every point, counting passes check the tiles and re-split any over budget. Then the
+// blocks are written in rounds of consecutive tiles holding at most round_points points, each
+// round re-reading the input and keeping only its tiles' points. Points are taken in input
+// order, sorted by a total order, and frames encoded in parallel but written in order, so the
+// bytes do not depend on threads or timing.
+#include <fmt/core.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+#include <zstd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include "g2s/error.hpp"
+#include "g2s/tile_store.hpp"
+#include "io/readers.hpp"
+#include "tiling/store_format.hpp"
+#include "tiling/tile_spacing.hpp"
+#include "tiling/tile_split.hpp"
+#include "tiling/xxhash64.hpp"
+
+namespace g2s {
+namespace {
+
+using namespace tiling;
+
+// Pass 1 holds up to twice this many sample points (32 bytes each: 17 MB); a cloud of at most
+// twice as many points is sampled whole, so its tiles are exact without a counting pass.
+constexpr std::size_t kSampleTarget = std::size_t{1} << 18;
+// A tile split on a partial sample aims this far below the budget, so that the counting pass
+// rarely finds one over it.
+constexpr double kSampledTargetFraction = 0.75;
+
+// Streams the finite points of the input with their global ids; returns the reader's report.
+template <class Visit>
+ReadReport for_each_point(const std::filesystem::path& input, Visit&& visit) {
+  ReadReport report;
+  std::uint64_t id = 0;
+  io::scan_points(
+      input,
+      [&](std::span<const double> xyz) {
+        for (std::size_t i = 0; i < xyz.size(); i += 3) visit(&xyz[i], id++);
+      },
+      report);
+  return report;
+}
+
+[[noreturn]] void throw_changed(const std::filesystem::path& input) {
+  throw Error(Exit::bad_input,
+              fmt::format("{}: the file changed while it was being tiled", input.string()));
+}
+
+// A later pass must see the cloud the first one saw.
+void check_unchanged(const std::filesystem::path& input, const ReadReport& first,
+                     const ReadReport& again) {
+  if (again.points != first.points || again.non_finite != first.non_finite) throw_changed(input);
+}
+
+// Exact point count of every leaf (indexed by node).
+std::vector<std::uint64_t> count_leaves(const std::filesystem::path& input, const TileTree& tree,
+                                        const ReadReport& first) {
+  std::vector<std::uint64_t> counts(tree.node_count(), 0);
+  const ReadReport again =
+      for_each_point(input, [&](const double* p, std::uint64_t) { ++counts[tree.leaf_of(p)]; });
+  check_unchanged(input, first, again);
+  return counts;
+}
+
+// Builds the tree and returns the exact point count of every node (leaves only are set).
+std::vector<std::uint64_t> split_into_tiles(const std::filesystem::path& input, TileTree& tree,
+                                            const PointSample& first_sample,
+                                            const ReadReport& first, std::uint64_t budget) {
+  const double sampled_target = static_cast<double>(budget) * kSampledTargetFraction;
+  if (first_sample.holds_every_point()) {
+    tree.split(0, first_sample, 1.0, static_cast<double>(budget));
+    std::vector<std::uint64_t> counts(tree.node_count(), 0);
+    for (std::size_t i = 0; i < first_sample.size(); ++i) {
+      ++counts[tree.leaf_of(first_sample.point(i))];
+    }
+    return counts;
+  }
+  tree.split(0, first_sample,
+             static_cast<double>(first.points) / static_cast<double>(first_sample.size()),
+             sampled_target);
+  for (;;) {
+    const std::vector<std::uint64_t> counts = count_leaves(input, tree, first);
+    std::vector<std::uint32_t> over;
+    for (std::uint32_t n = 0; n < tree.node_count(); ++n) {
+      if (tree.is_leaf(n) && counts[n] > budget) over.push_back(n);
+    }
+    if (over.empty()) return counts;
+    // A sample of each tile over budget, sharing the sample memory of pass 1.
+    std::vector<std::uint32_t> slot(tree.node_count(), kNoIndex);
+    std::vector<PointSample> samples;
+    const std::size_t per_tile = std::max<std::size_t>(kSampleTarget / over.size(), 64);
+    for (std::uint32_t i = 0; i < over.size(); ++i) {
+      slot[over[i]] = i;
+      samples.emplace_back(per_tile);
+    }
+    const ReadReport again = for_each_point(input, [&](const double* p, std::uint64_t id) {
+      const std::uint32_t s = slot[tree.leaf_of(p)];
+      if (s != kNoIndex) samples[s].add(p, id);
+    });
+    check_unchanged(input, first, again);
+    bool split_any = false;
+    for (std::uint32_t i = 0; i < over.size(); ++i) {
+      const PointSample& s = samples[i];
+      const bool exact = s.holds_every_point();
+      const double weight =
+          exact ? 1.0 : static_cast<double>(counts[over[i]]) / static_cast<double>(s.size());
+      split_any |=
+          tree.split(over[i], s, weight, exact ? static_cast<double>(budget) : sampled_target);
+    }
+    // Only tiles of coinciding points are left over budget: no plane separates them.
+    if (!split_any) return counts;
+  }
+}
+
+struct BlockEntry {
+  std::uint64_t offset = 0;
+  std::uint64_t bytes = 0;
+  std::uint64_t frame_table_checksum = 0;
+};
+
+// What a thread needs to encode frames: the decoded bytes and a zstd context, reused.
+struct FrameEncoder {
+  std::vector<unsigned char> raw;
+  ZSTD_CCtx* zstd = ZSTD_createCCtx();
+  FrameEncoder() = default;
+  FrameEncoder(const FrameEncoder&) : FrameEncoder() {}  // copies start fresh (TBB's exemplar)
+  FrameEncoder& operator=(const FrameEncoder&) = delete;
+  ~FrameEncoder() { ZSTD_freeCCtx(zstd); }
+};
+
+// Scratch buffers reused for every block.
+struct BlockScratch {
+  std::vector<std::pair<double, std::uint32_t>> order;
+  std::vector<unsigned char> frame_table;
+  std::vector<std::vector<unsigned char>> frames;  // each frame's stored bytes
+  std::vector<std::size_t> zstd_results;           // each frame's zstd return code
+  tbb::enumerable_thread_specific<FrameEncoder> encoders;
+};
+
+// Encodes one frame, the points `order` picks, into `stored` (compressed if asked); returns
+// zstd's result (an error code to check) or the raw size.
+std::size_t encode_frame(std::span<const double> xyz, std::span<const Index> ids,
+                         std::span<const std::pair<double, std::uint32_t>> order,
+                         const TileStoreOptions& options, FrameEncoder& encoder,
+                         std::vector<unsigned char>& stored) {
+  const std::size_t m = order.size();
+  std::vector<unsigned char>& raw = options.compress ? encoder.raw : stored;
+  raw.resize(m * kPointBytes);
+  unsigned char* out = raw.data();
+  for (std::size_t k = 0; k < m; ++k) {
+    const double* p = &xyz[3 * order[k].second];
+    for (int a = 0; a < 3; ++a) store_le(out + (3 * k + a) * sizeof(double), p[a]);
+  }
+  out += 3 * m * sizeof(double);
+  for (std::size_t k = 0; k < m; ++k) store_le(out + k * sizeof(Index), ids[order[k].second]);
+  if (!options.compress) return raw.size();
+  stored.resize(ZSTD_compressBound(raw.size()));
+  const std::size_t result = ZSTD_compressCCtx(encoder.zstd, stored.data(), stored.size(),
+                                               raw.data(), raw.size(), options.zstd_level);
+  stored.resize(ZSTD_isError(result) ? 0 : result);
+  return result;
+}
+
+// Writes one tile's block: its frame table, then its points ordered by border distance (ties
+// by id) in frames of kFramePoints, raw or zstd-compressed. The frames are encoded in parallel
+// into their own buffers and written in order, so the bytes do not depend on the threads.
+BlockEntry write_block(AtomicFile& file, std::span<const double> xyz, std::span<const Index> ids,
+                       const TileBox& box, const TileBox& bounds, const TileStoreOptions& options,
+                       BlockScratch& scratch) {
+  const std::size_t n = ids.size();
+  const BorderFaces faces(box, bounds);
+  // (distance, local index) pairs: the points came in id order, so the index breaks ties as
+  // the id would, and the pairs sort without chasing pointers.
+  scratch.order.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    scratch.order[i] = {faces.distance(&xyz[3 * i]), static_cast<std::uint32_t>(i)};
+  }
+  tbb::parallel_sort(scratch.order.begin(), scratch.order.end());
+
+  const std::size_t frames = frame_count(n, kFramePoints);
+  scratch.frames.resize(std::max(scratch.frames.size(), frames));
+  scratch.zstd_results.resize(frames);
+  tbb::parallel_for(std::size_t{0}, frames, [&](std::size_t f) {
+    const std::size_t first = f * kFramePoints;
+    const std::size_t m = std::min<std::size_t>(kFramePoints, n - first);
+    scratch.zstd_results[f] = encode_frame(xyz, ids, std::span(scratch.order).subspan(first, m),
+                                           options, scratch.encoders.local(), scratch.frames[f]);
+  });
+
+  BlockEntry entry;
+  entry.offset = file.size();
+  scratch.frame_table.assign(frames * kFrameEntryBytes, 0);
+  std::uint64_t offset = scratch.frame_table.size();
+  for (std::size_t f = 0; f < frames; ++f) {
+    if (ZSTD_isError(scratch.zstd_results[f])) {
+      throw Error(Exit::failure,
+                  fmt::format("{}: zstd compression failed: {}", file.target().string(),
+                              ZSTD_getErrorName(scratch.zstd_results[f])));
+    }
+    const std::vector<unsigned char>& stored = scratch.frames[f];
+    unsigned char* e = scratch.frame_table.data() + f * kFrameEntryBytes;
+    store_le(e + frame::offset, offset);
+    store_le(e + frame::stored_bytes, std::uint64_t{stored.size()});
+    store_le(e + frame::first_distance, scratch.order[f * kFramePoints].first);
+    store_le(e + frame::checksum, xxhash64(stored.data(), stored.size()));
+    offset += stored.size();
+  }
+  file.write(scratch.frame_table.data(), scratch.frame_table.size());
+  for (std::size_t f = 0; f < frames; ++f)
+    file.write(scratch.frames[f].data(), scratch.frames[f].size());
+  entry.bytes = file.size() - entry.offset;
+  entry.frame_table_checksum = xxhash64(scratch.frame_table.data(), scratch.frame_table.size());
+  return entry;
+}
+
+}  // namespace
+
+TileStoreReport build_tile_store(const std::filesystem::path& input,
+                                 const std::filesystem::path& store,
+                                 const TileStoreOptions& options) {
+  if (options.tile_points == 0) throw Error(Exit::usage, "tile points must be at least 1");
+  std::error_code ec;
+  const auto status = std::filesystem::status(input, ec);
+  if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status) &&
+      !std::filesystem::is_directory(status)) {
+    throw Error(Exit::bad_input,
+                fmt::format("{}: not a regular file (tiling reads its input several times, so a "
+                            "pipe or device cannot be tiled)",
+                            input.string()));
+  }
+
+  // Pass 1: bounding box and sample.
+  TileBox bounds;
+  for (int a = 0; a < 3; ++a) {
+    bounds.lo[a] = std::numeric_limits<double>::infinity();
+    bounds.hi[a] = -std::numeric_limits<double>::infinity();
+  }
+  PointSample sample(kSampleTarget);
+  const ReadReport first = for_each_point(input, [&](const double* p, std::uint64_t id) {
+    for (int a = 0; a < 3; ++a) {
+      bounds.lo[a] = std::min(bounds.lo[a], p[a]);
+      bounds.hi[a] = std::max(bounds.hi[a], p[a]);
+    }
+    sample.add(p, id);
+  });
+  if (first.points > kNoIndex) {
+    throw Error(Exit::bad_input,
+                fmt::format("{}: {} points; the tile store numbers points with 32 bits (at most "
+                            "{})",
+                            input.string(), first.points, kNoIndex));
+  }
+  if (first.points == 0) bounds = TileBox{};
+  const std::uint64_t total = first.points;
+  if (options.progress) options.progress(0, total);
+
+  TileTree tree(bounds);
+  std::vector<std::uint64_t> counts;
+  std::vector<std::uint32_t> leaves;
+  if (total > 0) {
+    counts = split_into_tiles(input, tree, sample, first, options.tile_points);
+    leaves = tree.leaves();
+  }
+  sample = PointSample(0);  // its memory is not needed while writing
+  const std::size_t tiles = leaves.size();
+  std::vector<std::uint32_t> tile_of_node(tree.node_count(), kNoIndex);
+  for (std::uint32_t t = 0; t < tiles; ++t) tile_of_node[leaves[t]] = t;
+
+  AtomicFile file(store);
+  std::vector<unsigned char> header(kHeaderBytes, 0);
+  std::vector<unsigned char> table(tiles * kEntryBytes, 0);
+  file.write(header.data(), header.size());
+  file.write(table.data(), table.size());
+
+  // Rounds: runs of consecutive tiles holding at most round_points points (at least one tile).
+  // The point buffers are sized once for the largest, so they never reallocate (a copy would
+  // double the peak).
+  const std::uint64_t round_points = std::max(options.round_points, options.tile_points);
+  std::vector<std::size_t> round_first = {0};
+  std::vector<std::uint64_t> start(tiles + 1, 0);  // each tile's offset in its round's buffers
+  std::uint64_t largest_round = 0;
+  for (std::size_t t = 0; t < tiles; ++t) {
+    const std::uint64_t held = start[t];
+    const std::uint64_t count = counts[leaves[t]];
+    if (held > 0 && held + count > round_points) {
+      round_first.push_back(t);
+      start[t] = 0;
+    }
+    start[t + 1] = start[t] + count;
+    largest_round = std::max(largest_round, start[t + 1]);
+  }
+  round_first.push_back(tiles);
+
+  BlockScratch scratch;
+  std::vector<double> xyz(largest_round * 3);
+  std::vector<Index> ids(largest_round);
+  std::uint64_t written = 0;
+  for (std::size_t round = 0; round + 1 < round_first.size(); ++round) {
+    const std::size_t round_begin = round_first[round];
+    const std::size_t round_end = round_first[round + 1];
+    std::vector<std::uint64_t> cursor(start.begin() + round_begin, start.begin() + round_end);
+    const ReadReport again = for_each_point(input, [&](const double* p, std::uint64_t id) {
+      const std::uint32_t t = tile_of_node[tree.leaf_of(p)];
+      if (t < round_begin || t >= round_end) return;
+      const std::uint64_t at = cursor[t - round_begin]++;
+      if (at - start[t] >= counts[leaves[t]]) throw_changed(input);  // before overrunning
+      std::copy_n(p, 3, &xyz[3 * at]);
+      ids[at] = static_cast<Index>(id);
+    });
+    check_unchanged(input, first, again);
+    for (std::size_t t = round_begin; t < round_end; ++t) {
+      const std::uint32_t node = leaves[t];
+      const std::size_t begin = start[t];
+      const std::size_t n = counts[node];
+      const std::span<const double> tile_xyz(xyz.data() + 3 * begin, 3 * n);
+      const BlockEntry block =
+          write_block(file, tile_xyz, std::span<const Index>(ids.data() + begin, n), tree.box(node),
+                      bounds, options, scratch);
+      unsigned char* e = table.data() + t * kEntryBytes;
+      for (int a = 0; a < 3; ++a) {
+        store_le(e + entry::box + 8 * a, tree.box(node).lo[a]);
+        store_le(e + entry::box + 24 + 8 * a, tree.box(node).hi[a]);
+      }
+      store_le(e + entry::points, std::uint64_t{n});
+      store_le(e + entry::spacing, estimate_tile_spacing(tile_xyz));
+      store_le(e + entry::block_offset, block.offset);
+      store_le(e + entry::block_bytes, block.bytes);
+      store_le(e + entry::frame_table_checksum, block.frame_table_checksum);
+      written += n;
+      if (options.progress) options.progress(written, total);
+    }
+  }
+
+  unsigned char* h = header.data();
+  std::memcpy(h + header::magic, kMagic, sizeof kMagic);
+  store_le(h + header::version, kVersion);
+  store_le(h + header::header_bytes, static_cast<std::uint32_t>(kHeaderBytes));
+  store_le(h + header::flags, options.compress ? kFlagCompressed : std::uint32_t{0});
+  store_le(h + header::frame_points, kFramePoints);
+  store_le(h + header::point_count, total);
+  store_le(h + header::tile_count, std::uint64_t{tiles});
+  for (int a = 0; a < 3; ++a) {
+    store_le(h + header::bounds + 8 * a, bounds.lo[a]);
+    store_le(h + header::bounds + 24 + 8 * a, bounds.hi[a]);
+  }
+  store_le(h + header::input_declared, first.declared);
+  store_le(h + header::input_points, first.points);
+  store_le(h + header::input_non_finite, first.non_finite);
+  std::memcpy(h + header::input_format, first.format.data(),
+              std::min(first.format.size(), kFormatChars - 1));
+  store_le(h + header::table_offset, std::uint64_t{kHeaderBytes});
+  store_le(h + header::table_bytes, std::uint64_t{table.size()});
+  store_le(h + header::file_bytes, file.size());
+  store_le(h + header::table_checksum, xxhash64(table.data(), table.size()));
+  store_le(h + header::header_checksum, xxhash64(h, header::header_checksum));
+  file.write_at(0, header.data(), header.size());
+  file.write_at(kHeaderBytes, table.data(), table.size());
+  TileStoreReport report;
+  report.read = first;
+  report.tiles = tiles;
+  report.bytes = file.size();
+  file.commit();
+  return report;
+}
+
+}  // namespace g2s

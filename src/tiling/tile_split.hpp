@@ -1,0 +1,94 @@
+// The adaptive split of the tile store (ALGORITHM.md §7.1, docs/tile-store.md "Adaptive
+// split"): a k-d tree over the cloud's bounding box whose leaves are the tiles. A leaf holding
+// too many points is cut across its longest axis: at the box's midpoint when that leaves each
+// side at least 1/8 of its points (compact tiles, closing in on dense regions), else at a
+// quantile of a sample of its points (the median when it needs two tiles, k/2 of k when it
+// needs k, so tiles come out nearly full). Empty space costs nothing. The sample is a
+// deterministic hash of the points' global ids, so the tiles do not depend on chunking,
+// threads or timing.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "g2s/tile_store.hpp"
+
+namespace g2s::tiling {
+
+// Points offered while streaming are kept when a hash of their id is below a threshold; the
+// threshold halves (dropping the kept points above it) whenever more than 2 * target are held.
+// So at most 2 * target points are held, and which ones only depends on the ids offered.
+class PointSample {
+ public:
+  explicit PointSample(std::size_t target) : target_(target) {}
+
+  void add(const double* p, std::uint64_t id) {
+    const std::uint64_t h = hash(id);
+    if (h >= threshold_) return;
+    xyz_.insert(xyz_.end(), p, p + 3);
+    hashes_.push_back(h);
+    if (hashes_.size() > 2 * target_) shrink();
+  }
+  // True while every point offered is held (the threshold was never lowered).
+  bool holds_every_point() const { return threshold_ == ~std::uint64_t{0}; }
+  std::size_t size() const { return hashes_.size(); }
+  const double* point(std::size_t i) const { return xyz_.data() + 3 * i; }
+
+ private:
+  static std::uint64_t hash(std::uint64_t id) {  // splitmix64's finaliser
+    id += 0x9E3779B97F4A7C15ull;
+    id = (id ^ (id >> 30)) * 0xBF58476D1CE4E5B9ull;
+    id = (id ^ (id >> 27)) * 0x94D049BB133111EBull;
+    return id ^ (id >> 31);
+  }
+  void shrink();
+
+  std::size_t target_;
+  std::uint64_t threshold_ = ~std::uint64_t{0};
+  std::vector<double> xyz_;
+  std::vector<std::uint64_t> hashes_;
+};
+
+// A k-d tree as flat arrays of nodes; node 0 is the root (the cloud's bounding box). A point p
+// goes to the right child when p[axis] >= split, so a leaf owns lo <= p < hi, and the leaves
+// on the cloud's upper faces own the points lying on them.
+class TileTree {
+ public:
+  explicit TileTree(const TileBox& bounds) { nodes_.push_back(Node{bounds}); }
+
+  std::uint32_t leaf_of(const double* p) const {
+    std::uint32_t n = 0;
+    while (nodes_[n].axis >= 0) {
+      const Node& node = nodes_[n];
+      n = p[node.axis] < node.split ? node.left : node.right;
+    }
+    return n;
+  }
+  std::size_t node_count() const { return nodes_.size(); }
+  bool is_leaf(std::uint32_t node) const { return nodes_[node].axis < 0; }
+  const TileBox& box(std::uint32_t node) const { return nodes_[node].box; }
+
+  // Splits leaf `node` by the points of `sample` (all in that leaf), each standing for `weight`
+  // points, until no new leaf is estimated above `target` points or a leaf's sample points all
+  // coincide. Returns whether the leaf was split.
+  bool split(std::uint32_t node, const PointSample& sample, double weight, double target);
+
+  // The leaves in depth-first order, lower side first: the tile order (neighbours in space are
+  // mostly near in the file).
+  std::vector<std::uint32_t> leaves() const;
+
+ private:
+  struct Node {
+    TileBox box;
+    int axis = -1;  // -1 for a leaf
+    double split = 0.0;
+    std::uint32_t left = 0;
+    std::uint32_t right = 0;
+  };
+  void split_range(std::uint32_t node, const PointSample& sample, std::uint32_t* begin,
+                   std::uint32_t* end, double weight, double target);
+
+  std::vector<Node> nodes_;
+};
+
+}  // namespace g2s::tiling

@@ -1,0 +1,561 @@
+// Tests of the tile store (src/tiling/, docs/tile-store.md): the streaming reader agrees with
+// read_points; a store gives back every point with its id, bit for bit, raw or compressed; tiles
+// partition the cloud within budget and shrink where it is dense; load_border is exactly the
+// points within the distance; the bytes are deterministic; every kind of damage is reported
+// by name, never crashed on; and the g2s tile / tile-info commands.
+#include "g2s/tile_store.hpp"
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <stdlib.h>
+#include <sys/wait.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <zstd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <iterator>
+#include <limits>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "g2s/error.hpp"
+#include "g2s/io.hpp"
+#include "g2s/synth.hpp"
+#include "io/readers.hpp"
+#include "tiling/xxhash64.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using g2s::Exit;
+
+class TileStoreTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string pattern = (fs::temp_directory_path() / "g2s-tile-store-XXXXXX").string();
+    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
+    dir_ = pattern;
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  fs::path write(const std::string& name, std::string_view bytes) {
+    const fs::path path = dir_ / name;
+    std::ofstream out(path, std::ios::binary);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    return path;
+  }
+  // Text XYZ with the doubles printed exactly.
+  fs::path write_xyz(const std::string& name, const std::vector<double>& xyz) {
+    std::string text;
+    for (std::size_t i = 0; i < xyz.size(); i += 3) {
+      text += fmt::format("{} {} {}\n", xyz[i], xyz[i + 1], xyz[i + 2]);
+    }
+    return write(name, text);
+  }
+  fs::path synthetic(const std::string& name, g2s::SynthShape shape, std::uint64_t points) {
+    g2s::SynthOptions options;
+    options.shape = shape;
+    options.points = points;
+    options.outliers = 0.001;
+    const fs::path path = dir_ / name;
+    g2s::write_synthetic_cloud(path, options);
+    return path;
+  }
+  fs::path build(const fs::path& input, const std::string& name, std::uint64_t tile_points,
+                 bool compress, std::uint64_t round_points = std::uint64_t{8} << 20) {
+    g2s::TileStoreOptions options;
+    options.tile_points = tile_points;
+    options.compress = compress;
+    options.round_points = round_points;
+    const fs::path store = dir_ / name;
+    g2s::build_tile_store(input, store, options);
+    return store;
+  }
+  fs::path dir_;
+};
+
+std::string read_bytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+template <typename F>
+void expect_error(F&& f, Exit code, std::initializer_list<std::string_view> parts) {
+  try {
+    f();
+    ADD_FAILURE() << "no exception thrown";
+  } catch (const g2s::Error& e) {
+    EXPECT_EQ(static_cast<int>(e.code()), static_cast<int>(code)) << e.what();
+    const std::string_view what = e.what();
+    for (std::string_view part : parts) {
+      EXPECT_NE(what.find(part), std::string_view::npos)
+          << "message: " << what << "\nshould contain: " << part;
+    }
+  }
+}
+
+// Distance to the nearest face of the box that is not on the cloud's bounding box, written
+// out independently of the library's.
+double border_distance(const double* p, const g2s::TileBox& box, const g2s::TileBox& bounds) {
+  double d = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    if (box.lo[a] != bounds.lo[a]) d = std::min(d, p[a] - box.lo[a]);
+    if (box.hi[a] != bounds.hi[a]) d = std::min(d, box.hi[a] - p[a]);
+  }
+  return d;
+}
+
+bool inside(const double* p, const g2s::TileBox& box, const g2s::TileBox& bounds) {
+  for (int a = 0; a < 3; ++a) {
+    if (p[a] < box.lo[a] || p[a] > box.hi[a]) return false;
+    if (p[a] == box.hi[a] && box.hi[a] != bounds.hi[a]) return false;  // owned by the neighbour
+  }
+  return true;
+}
+
+// Checks that the store holds exactly `cloud`, every point once with its id, inside its tile,
+// no tile over budget. Returns the tile of every point.
+std::vector<std::size_t> expect_partition(const g2s::TileStore& store, const g2s::PointCloud& cloud,
+                                          std::uint64_t budget) {
+  std::vector<std::size_t> tile_of(cloud.size(), ~std::size_t{0});
+  EXPECT_EQ(store.point_count(), cloud.size());
+  for (std::size_t t = 0; t < store.tiles().size(); ++t) {
+    const g2s::TileInfo& info = store.tiles()[t];
+    const g2s::TilePoints pts = store.load(t);
+    EXPECT_EQ(pts.size(), info.points);
+    EXPECT_LE(info.points, budget) << "tile " << t;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const g2s::Index id = pts.ids[i];
+      if (id >= cloud.size()) {
+        ADD_FAILURE() << "id " << id << " out of range";
+        continue;
+      }
+      EXPECT_EQ(tile_of[id], ~std::size_t{0}) << "point " << id << " in two tiles";
+      tile_of[id] = t;
+      for (int a = 0; a < 3; ++a) {
+        // Bit-exact: the same doubles read_points returns.
+        EXPECT_EQ(pts.xyz[3 * i + a], cloud.xyz[3 * id + a]) << "point " << id;
+      }
+      EXPECT_TRUE(inside(&pts.xyz[3 * i], info.box, store.bounds()))
+          << "point " << id << " outside tile " << t;
+    }
+  }
+  for (std::size_t id = 0; id < tile_of.size(); ++id) {
+    if (tile_of[id] == ~std::size_t{0}) {
+      ADD_FAILURE() << "point " << id << " in no tile";
+      break;
+    }
+  }
+  return tile_of;
+}
+
+// ---- checksum and streaming reader ----
+
+TEST(TileXxHash64, KnownValuesAndZstdFrameChecksum) {
+  EXPECT_EQ(g2s::tiling::xxhash64("", 0), 0xEF46DB3751D8E999ull);
+  EXPECT_EQ(g2s::tiling::xxhash64("abc", 3), 0x44BC2CF5AD770999ull);
+  // zstd ends a frame with the low 32 bits of XXH64 of its content: check every tail length.
+  ZSTD_CCtx* cctx = ZSTD_createCCtx();
+  ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 1);
+  std::vector<unsigned char> data(1000);
+  for (std::size_t i = 0; i < data.size(); ++i) data[i] = static_cast<unsigned char>(i * 7 + 3);
+  std::vector<unsigned char> frame(ZSTD_compressBound(data.size()));
+  for (std::size_t len : {1u, 5u, 31u, 32u, 33u, 63u, 100u, 1000u}) {
+    const std::size_t size = ZSTD_compress2(cctx, frame.data(), frame.size(), data.data(), len);
+    ASSERT_FALSE(ZSTD_isError(size));
+    std::uint32_t stored;
+    std::memcpy(&stored, frame.data() + size - 4, 4);
+    EXPECT_EQ(stored, static_cast<std::uint32_t>(g2s::tiling::xxhash64(data.data(), len)))
+        << "length " << len;
+  }
+  ZSTD_freeCCtx(cctx);
+}
+
+TEST_F(TileStoreTest, ScanPointsStreamsWhatReadPointsReads) {
+  const std::string body = "1 2 3\nnan 0 0\n4 5 6\n7 8 inf\n9 10 11\n";
+  const fs::path ply = write("a.ply",
+                             "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\n"
+                             "property float y\nproperty float z\nend_header\n" +
+                                 body);
+  const fs::path big = synthetic("big.ply", g2s::SynthShape::torus, 1'300'000);  // 2 runs
+  for (const fs::path& path : {write("a.xyz", body), ply, big}) {
+    g2s::ReadReport expected_report;
+    const g2s::PointCloud expected = g2s::read_points(path, &expected_report);
+    std::vector<double> streamed;
+    std::size_t runs = 0;
+    g2s::ReadReport report;
+    g2s::io::scan_points(
+        path,
+        [&](std::span<const double> xyz) {
+          ++runs;
+          streamed.insert(streamed.end(), xyz.begin(), xyz.end());
+        },
+        report);
+    EXPECT_EQ(streamed, expected.xyz) << path;
+    EXPECT_EQ(report.format, expected_report.format);
+    EXPECT_EQ(report.points, expected_report.points);
+    EXPECT_EQ(report.non_finite, expected_report.non_finite);
+    EXPECT_EQ(report.declared, expected_report.declared);
+    if (path == big) {
+      EXPECT_EQ(runs, 2u);
+    }
+  }
+}
+
+TEST_F(TileStoreTest, ScanPointsFailsLikeReadPoints) {
+  const std::string header =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+      "property float y\nproperty float z\nend_header\n";
+  const fs::path truncated = write("t.ply", header + std::string(20, '\0'));
+  const fs::path bad_text = write("bad.xyz", "1 2 3\n4 5\n");
+  for (const fs::path& path : {truncated, bad_text, dir_ / "missing.ply"}) {
+    std::string expected;
+    try {
+      g2s::read_points(path);
+    } catch (const g2s::Error& e) {
+      expected = e.what();
+    }
+    ASSERT_FALSE(expected.empty());
+    g2s::ReadReport report;
+    expect_error(
+        [&] {
+          g2s::io::scan_points(
+              path, [](std::span<const double>) {}, report);
+        },
+        Exit::bad_input, {expected});
+    g2s::TileStoreOptions options;
+    expect_error([&] { g2s::build_tile_store(path, dir_ / "s.tiles", options); }, Exit::bad_input,
+                 {expected});
+    EXPECT_FALSE(fs::exists(dir_ / "s.tiles"));
+  }
+}
+
+// ---- writing and loading ----
+
+TEST_F(TileStoreTest, RoundTripRawAndCompressed) {
+  const fs::path input = synthetic("sphere.ply", g2s::SynthShape::sphere, 30'000);
+  g2s::ReadReport read_report;
+  const g2s::PointCloud cloud = g2s::read_points(input, &read_report);
+  for (const bool compress : {false, true}) {
+    const g2s::TileStore store(build(input, compress ? "z.tiles" : "r.tiles", 1000, compress));
+    EXPECT_EQ(store.compressed(), compress);
+    EXPECT_EQ(store.input_report().format, "ply-binary-le");
+    EXPECT_EQ(store.input_report().points, read_report.points);
+    EXPECT_EQ(store.input_report().declared, read_report.declared);
+    EXPECT_GE(store.tiles().size(), 31u);
+    expect_partition(store, cloud, 1000);
+  }
+}
+
+TEST_F(TileStoreTest, TextInputWithNonFinitePoints) {
+  std::vector<double> xyz;
+  for (int i = 0; i < 500; ++i) {
+    xyz.insert(xyz.end(), {std::cos(i * 0.1) * 3, std::sin(i * 0.1) * 3, i * 0.01});
+  }
+  std::string text = "# comment\n";
+  for (std::size_t i = 0; i < xyz.size(); i += 3) {
+    text += fmt::format("{} {} {}\n", xyz[i], xyz[i + 1], xyz[i + 2]);
+    if (i % 30 == 0) text += "nan 1 1\n";
+  }
+  const fs::path input = write("c.xyz", text);
+  const g2s::TileStore store(build(input, "c.tiles", 64, true));
+  EXPECT_EQ(store.input_report().format, "xyz");
+  EXPECT_EQ(store.input_report().non_finite, 50u);
+  expect_partition(store, g2s::read_points(input), 64);
+}
+
+TEST_F(TileStoreTest, EmptyCloudGivesAnEmptyStore) {
+  const fs::path input = write("e.xyz", "# nothing\n");
+  const g2s::TileStore store(build(input, "e.tiles", 10, false));
+  EXPECT_EQ(store.point_count(), 0u);
+  EXPECT_EQ(store.tiles().size(), 0u);
+}
+
+TEST_F(TileStoreTest, DenseClusterGetsSmallerTiles) {
+  // 20k points spread over a 10-unit cube, 20k more packed in a 0.5-unit cube at its centre.
+  std::vector<double> xyz;
+  std::uint64_t state = 12345;
+  auto uniform = [&] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<double>(state >> 11) / static_cast<double>(1ull << 53);
+  };
+  for (int i = 0; i < 20000; ++i)
+    xyz.insert(xyz.end(), {10 * uniform(), 10 * uniform(), 10 * uniform()});
+  for (int i = 0; i < 20000; ++i) {
+    xyz.insert(xyz.end(), {5 + 0.5 * uniform(), 5 + 0.5 * uniform(), 5 + 0.5 * uniform()});
+  }
+  const fs::path input = write_xyz("cluster.xyz", xyz);
+  const g2s::TileStore store(build(input, "cluster.tiles", 2000, false));
+  const std::vector<std::size_t> tile_of = expect_partition(store, g2s::read_points(input), 2000);
+  auto volume = [&](std::size_t t) {
+    const g2s::TileBox& b = store.tiles()[t].box;
+    return (b.hi[0] - b.lo[0]) * (b.hi[1] - b.lo[1]) * (b.hi[2] - b.lo[2]);
+  };
+  // The typical tile of a cluster point is over 100 times smaller than that of a spread point
+  // away from the cluster.
+  std::vector<double> cluster_volumes, spread_volumes;
+  for (std::size_t i = 0; i < 40000; ++i) {
+    if (i >= 20000) {
+      cluster_volumes.push_back(volume(tile_of[i]));
+    } else if (std::abs(xyz[3 * i] - 5.25) > 2) {
+      spread_volumes.push_back(volume(tile_of[i]));
+    }
+  }
+  auto median = [](std::vector<double>& v) {
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  EXPECT_LT(median(cluster_volumes) * 100, median(spread_volumes));
+}
+
+TEST_F(TileStoreTest, PointsOnTheOuterFacesGiveNoFlatTiles) {
+  // The cube's points lie exactly on its faces: many share the largest coordinate. A tile cut
+  // there would be a flat slab on the cloud's face, which its neighbour's border would miss.
+  const fs::path input = synthetic("cube.ply", g2s::SynthShape::cube, 50'000);
+  for (const std::uint64_t budget : {500u, 3000u, 9000u}) {
+    const g2s::TileStore store(build(input, "cube.tiles", budget, false));
+    expect_partition(store, g2s::read_points(input), budget);
+    for (std::size_t t = 0; t < store.tiles().size(); ++t) {
+      const g2s::TileBox& b = store.tiles()[t].box;
+      for (int a = 0; a < 3; ++a) {
+        EXPECT_LT(b.lo[a], b.hi[a]) << "tile " << t << " is flat on axis " << a;
+      }
+    }
+  }
+}
+
+TEST_F(TileStoreTest, LoadBorderIsExactlyThePointsWithinTheDistance) {
+  // Tiles of about 100k points, several frames each, so frame selection is exercised too.
+  const fs::path input = synthetic("torus.ply", g2s::SynthShape::torus, 400'000);
+  for (const bool compress : {false, true}) {
+    const g2s::TileStore store(build(input, compress ? "z.tiles" : "r.tiles", 120'000, compress));
+    ASSERT_GE(store.tiles().size(), 4u);
+    for (std::size_t t = 0; t < store.tiles().size(); ++t) {
+      const g2s::TileInfo& info = store.tiles()[t];
+      EXPECT_GT(info.points, 5 * 16384u);  // several frames
+      const g2s::TilePoints all = store.load(t);
+      const double s = info.spacing;
+      ASSERT_GT(s, 0);
+      for (const double d :
+           {-1.0, 0.0, s, 3 * s, 40 * s, 0.3, 1e9, std::numeric_limits<double>::infinity()}) {
+        const g2s::TilePoints border = store.load_border(t, d);
+        std::size_t expected = 0;
+        for (std::size_t i = 0; i < all.size(); ++i) {
+          expected += border_distance(&all.xyz[3 * i], info.box, store.bounds()) <= d;
+        }
+        ASSERT_EQ(border.size(), expected) << "tile " << t << " distance " << d;
+        // A prefix of the block: the same points in the same order.
+        for (std::size_t i = 0; i < border.size(); ++i) {
+          ASSERT_EQ(border.ids[i], all.ids[i]);
+          ASSERT_LE(border_distance(&border.xyz[3 * i], info.box, store.bounds()), d);
+        }
+      }
+    }
+  }
+}
+
+TEST_F(TileStoreTest, BytesAreDeterministicWhateverTheRoundsAndThreads) {
+  const fs::path input = synthetic("cube.ply", g2s::SynthShape::cube, 50'000);
+  for (const bool compress : {false, true}) {
+    const std::string once = read_bytes(build(input, "a.tiles", 3000, compress));
+    const std::string again = read_bytes(build(input, "b.tiles", 3000, compress));
+    // One tile per round: the input is re-read about 17 times, the bytes are the same.
+    const std::string rounds = read_bytes(build(input, "c.tiles", 3000, compress, 1));
+    std::string one_thread;
+    {
+      const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+      one_thread = read_bytes(build(input, "d.tiles", 3000, compress));
+    }
+    EXPECT_EQ(once, again);
+    EXPECT_EQ(once, rounds);
+    EXPECT_EQ(once, one_thread);
+  }
+}
+
+TEST_F(TileStoreTest, SampledSplitIsCheckedByCounting) {
+  // More points than pass 1 samples whole (2^19): tiles are cut on a sample, then counted.
+  const fs::path input = synthetic("uneven.ply", g2s::SynthShape::uneven, 700'000);
+  const g2s::TileStore store(build(input, "u.tiles", 20'000, true));
+  EXPECT_GE(store.tiles().size(), 36u);
+  expect_partition(store, g2s::read_points(input), 20'000);
+}
+
+TEST_F(TileStoreTest, ConcurrentLoadsAgree) {
+  const fs::path input = synthetic("sphere.ply", g2s::SynthShape::sphere, 20'000);
+  const g2s::TileStore store(build(input, "s.tiles", 500, true));
+  std::vector<g2s::TilePoints> parallel(store.tiles().size());
+  tbb::parallel_for(std::size_t{0}, parallel.size(),
+                    [&](std::size_t t) { parallel[t] = store.load_border(t, 0.05); });
+  for (std::size_t t = 0; t < parallel.size(); ++t) {
+    EXPECT_EQ(parallel[t].ids, store.load_border(t, 0.05).ids);
+  }
+}
+
+// ---- damage ----
+
+class TileStoreDamage : public TileStoreTest {
+ protected:
+  void SetUp() override {
+    TileStoreTest::SetUp();
+    const fs::path input = synthetic("sphere.ply", g2s::SynthShape::sphere, 5000);
+    store_ = build(input, "s.tiles", 1000, true);
+    bytes_ = read_bytes(store_);
+  }
+  fs::path damaged(const std::string& bytes) { return write("damaged.tiles", bytes); }
+  std::string flipped(std::size_t offset) const {
+    std::string b = bytes_;
+    b[offset] = static_cast<char>(b[offset] ^ 0x10);
+    return b;
+  }
+  std::uint64_t u64(std::size_t offset) const {
+    std::uint64_t v;
+    std::memcpy(&v, bytes_.data() + offset, 8);
+    return v;
+  }
+  fs::path store_;
+  std::string bytes_;
+};
+
+TEST_F(TileStoreDamage, FlippedHeaderByte) {
+  const fs::path path = damaged(flipped(24));  // the point count
+  expect_error([&] { g2s::TileStore s(path); }, Exit::bad_input,
+               {path.string() + ": ", "header checksum mismatch"});
+}
+
+TEST_F(TileStoreDamage, FlippedTableByte) {
+  const fs::path path = damaged(flipped(192 + 96 + 50));  // tile 1's point count
+  expect_error([&] { g2s::TileStore s(path); }, Exit::bad_input,
+               {path.string() + ": ", "tile table checksum mismatch"});
+}
+
+TEST_F(TileStoreDamage, FlippedBlockBytes) {
+  const std::uint64_t block = u64(192 + 2 * 96 + 64);  // tile 2's block offset
+  {
+    const fs::path path = damaged(flipped(block + 10));  // its frame table
+    const g2s::TileStore store(path);                    // blocks are checked when loaded
+    EXPECT_EQ(store.load(0).size(), store.tiles()[0].points);
+    expect_error([&] { store.load(2); }, Exit::bad_input,
+                 {path.string() + ": ", "tile 2: frame table checksum mismatch"});
+  }
+  {
+    const fs::path path = damaged(flipped(block + 32 + 100));  // its first frame
+    const g2s::TileStore store(path);
+    expect_error([&] { store.load_border(2, 1e9); }, Exit::bad_input,
+                 {path.string() + ": ", "tile 2 frame 0: checksum mismatch"});
+    // A border too thin to need any frame reads none.
+    EXPECT_EQ(store.load_border(2, -1).size(), 0u);
+  }
+}
+
+TEST_F(TileStoreDamage, EveryByteIsCoveredByAChecksum) {
+  // Whichever byte is flipped, opening the store or loading its tiles reports it.
+  for (std::size_t offset = 0; offset < bytes_.size(); offset += 61) {
+    const fs::path path = damaged(flipped(offset));
+    try {
+      const g2s::TileStore store(path);
+      for (std::size_t t = 0; t < store.tiles().size(); ++t) store.load(t);
+      ADD_FAILURE() << "byte " << offset << " flipped unnoticed";
+    } catch (const g2s::Error& e) {
+      EXPECT_EQ(static_cast<int>(e.code()), static_cast<int>(Exit::bad_input)) << e.what();
+    }
+  }
+}
+
+TEST_F(TileStoreDamage, Truncated) {
+  for (const std::size_t size : {std::size_t{3}, std::size_t{8}, std::size_t{100}, std::size_t{192},
+                                 std::size_t{400}, bytes_.size() / 2, bytes_.size() - 1}) {
+    const fs::path path = damaged(bytes_.substr(0, size));
+    expect_error([&] { g2s::TileStore s(path); }, Exit::bad_input,
+                 {path.string() + ": ", "truncated"});
+  }
+  const fs::path path = damaged(bytes_ + "x");
+  expect_error([&] { g2s::TileStore s(path); }, Exit::bad_input, {"the header says"});
+}
+
+TEST_F(TileStoreDamage, VersionMagicAndEmptyFile) {
+  std::string newer = bytes_;
+  newer[8] = 2;
+  const fs::path path = damaged(newer);
+  expect_error([&] { g2s::TileStore s(path); }, Exit::bad_input,
+               {"store version 2, this g2s reads 1"});
+  const fs::path ply = dir_ / "sphere.ply";
+  expect_error([&] { g2s::TileStore s(ply); }, Exit::bad_input,
+               {ply.string() + ": ", "not a g2s tile store"});
+  const fs::path empty = write("empty.tiles", "");
+  expect_error([&] { g2s::TileStore s(empty); }, Exit::bad_input, {"file is empty"});
+  expect_error([&] { g2s::TileStore s(dir_ / "missing.tiles"); }, Exit::bad_input,
+               {"missing.tiles", "cannot open"});
+}
+
+// ---- a real scan and the command line ----
+
+TEST_F(TileStoreTest, RealScanBun000At1000PointsPerTile) {
+  const char* env = std::getenv("G2S_DATA_DIR");
+  const fs::path data = env && *env ? fs::path(env) : fs::path(G2S_DEFAULT_DATA_DIR);
+  const fs::path input = data / "open-bunny-scan-bun000.ply";
+  if (!fs::exists(input)) GTEST_SKIP() << "no " << input << " (set G2S_DATA_DIR)";
+  const g2s::PointCloud cloud = g2s::read_points(input);
+  const g2s::TileStore store(build(input, "bun000.tiles", 1000, true));
+  EXPECT_GE(store.tiles().size(), (cloud.size() + 999) / 1000);
+  EXPECT_LE(store.tiles().size(), 2 * (cloud.size() + 999) / 1000);
+  expect_partition(store, cloud, 1000);
+  // The scan's spacing is about 0.0007 (its README); every tile's estimate is near it.
+  for (const g2s::TileInfo& info : store.tiles()) {
+    EXPECT_GT(info.spacing, 0.0002);
+    EXPECT_LT(info.spacing, 0.003);
+  }
+}
+
+int run_cli(const std::string& args, const fs::path& out_path, std::string& output) {
+  const std::string command =
+      std::string("\"") + G2S_CLI_PATH + "\" " + args + " > \"" + out_path.string() + "\" 2>&1";
+  const int status = std::system(command.c_str());
+  output = read_bytes(out_path);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST_F(TileStoreTest, CliTileAndTileInfo) {
+  const fs::path input = synthetic("sphere.ply", g2s::SynthShape::sphere, 5000);
+  const fs::path store = dir_ / "s.tiles";
+  const fs::path out = dir_ / "out.txt";
+  std::string output;
+  ASSERT_EQ(run_cli(fmt::format("tile \"{}\" \"{}\" --tile-points 800 --compress --json",
+                                input.string(), store.string()),
+                    out, output),
+            0)
+      << output;
+  EXPECT_NE(output.find("\"points\":5005"), std::string::npos) << output;
+  EXPECT_NE(output.find("\"compressed\":true"), std::string::npos) << output;
+  ASSERT_EQ(run_cli(fmt::format("tile-info \"{}\"", store.string()), out, output), 0) << output;
+  EXPECT_NE(output.find("points:     5005"), std::string::npos) << output;
+  ASSERT_EQ(run_cli(fmt::format("tile-info \"{}\" --json", store.string()), out, output), 0);
+  EXPECT_NE(output.find("\"tiles\":[{\"points\":"), std::string::npos) << output;
+
+  // A damaged block: tile-info reads every block, so it fails with exit 3 naming the tile.
+  std::string bytes = read_bytes(store);
+  bytes[bytes.size() - 10] = static_cast<char>(bytes[bytes.size() - 10] ^ 1);
+  const fs::path corrupt = write("corrupt.tiles", bytes);
+  EXPECT_EQ(run_cli(fmt::format("tile-info \"{}\"", corrupt.string()), out, output), 3);
+  EXPECT_NE(output.find("checksum mismatch"), std::string::npos) << output;
+  EXPECT_EQ(run_cli(fmt::format("tile \"{}\" \"{}\"", (dir_ / "none.ply").string(),
+                                (dir_ / "x.tiles").string()),
+                    out, output),
+            3);
+  EXPECT_EQ(run_cli(fmt::format("tile \"{}\" \"{}\" --tile-points 0", input.string(),
+                                (dir_ / "x.tiles").string()),
+                    out, output),
+            2);
+}
+
+}  // namespace

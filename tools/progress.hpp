@@ -1,0 +1,40 @@
+// Shared by the subcommands: the one-line progress bar on a terminal and the peak memory for
+// the summary line.
+#pragma once
+
+#include <fmt/core.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <string>
+
+namespace g2s::cli {
+
+inline double peak_rss_mb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
+}
+
+// A one-line progress bar on stderr, redrawn in place; only when stderr is a terminal.
+class Progress {
+ public:
+  explicit Progress(bool enabled) : enabled_(enabled && isatty(STDERR_FILENO)) {}
+  void stage(const char* name, double fraction) {
+    if (!enabled_) return;
+    const int width = 30;
+    const int done = static_cast<int>(fraction * width + 0.5);
+    fmt::print(stderr, "\r{:<10} [{:<{}}] {:3.0f}%", name, std::string(done, '#'), width,
+               fraction * 100);
+    std::fflush(stderr);
+  }
+  void clear() {
+    if (enabled_) fmt::print(stderr, "\r{:60}\r", "");
+  }
+
+ private:
+  bool enabled_;
+};
+
+}  // namespace g2s::cli
