@@ -1,125 +1,115 @@
-// g2s mesh: read a cloud, mesh it, write the mesh, print a summary and the mesh's defects.
+// g2s mesh: the whole pipeline in one process. The cloud is cut into a tile store (a temporary
+// beside the output, or --keep-store), the tiles are grown in parallel, the seams stitched, and
+// the mesh written with a summary of its defects. `g2s tile`, `g2s grow` and `g2s stitch` run the
+// same stages as separate processes and give the same bytes.
 #include <fmt/core.h>
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <chrono>
-#include <cstdio>
+#include <filesystem>
 
 #include "commands.hpp"
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
-#include "g2s/mesher.hpp"
 #include "g2s/pipeline.hpp"
-#include "g2s/stats.hpp"
+#include "g2s/tile_store.hpp"
+#include "mesh_output.hpp"
+#include "progress.hpp"
 
 namespace g2s::cli {
 namespace {
 
 struct MeshArgs {
   std::string input;
-  std::string output;
+  OutputArgs out;
   int threads = 0;
-  bool ascii = false;
-  bool quiet = false;
-  bool json = false;
-  bool no_stats = false;
   std::uint64_t tile_points = std::uint64_t{1} << 20;
+  std::string keep_store;
+  bool compress = false;
   PipelineOptions options;
 };
 
-double peak_rss_mb() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
+// A kept store is reused when it is newer than the input (a re-run after an interruption, or
+// with other mesh options); anything else re-tiles.
+bool reusable(const std::filesystem::path& store, const std::filesystem::path& input) {
+  std::error_code error;
+  const auto store_time = std::filesystem::last_write_time(store, error);
+  if (error) return false;
+  const auto input_time = std::filesystem::last_write_time(input, error);
+  return !error && store_time >= input_time;
 }
 
-// A one-line progress bar on stderr, redrawn in place; only when stderr is a terminal.
-class Progress {
- public:
-  explicit Progress(bool enabled) : enabled_(enabled && isatty(STDERR_FILENO)) {}
-  void stage(const char* name, double fraction) {
-    if (!enabled_) return;
-    const int width = 30;
-    const int done = static_cast<int>(fraction * width + 0.5);
-    fmt::print(stderr, "\r{:<10} [{:<{}}] {:3.0f}%", name, std::string(done, '#'), width,
-               fraction * 100);
-    std::fflush(stderr);
-  }
-  void clear() {
-    if (enabled_) fmt::print(stderr, "\r{:60}\r", "");
-  }
-
- private:
-  bool enabled_;
-};
-
 void run_mesh(MeshArgs& args) {
-  args.options.threads = args.threads;
-  Progress progress(!args.quiet && !args.json);
-  const auto t0 = std::chrono::steady_clock::now();
-  progress.stage("reading", 0);
-  ReadReport read_report;
-  PointCloud cloud = read_points(args.input, &read_report);
-  if (cloud.size() == 0) {
-    throw Error(Exit::bad_input,
-                fmt::format("{}: no usable points ({} read, {} non-finite)", args.input,
-                            read_report.points + read_report.non_finite, read_report.non_finite));
+  Progress progress(!args.out.quiet && !args.out.json);
+  const RunFacts facts{args.input, 0, std::chrono::steady_clock::now()};
+  std::unique_ptr<TemporaryPath> temporary;
+  std::filesystem::path store_path = args.keep_store;
+  if (store_path.empty()) {
+    const std::filesystem::path output(args.out.output);
+    temporary = std::make_unique<TemporaryPath>(
+        output.parent_path() /
+        fmt::format(".{}.store-{}", output.filename().string(), static_cast<long>(getpid())));
+    store_path = temporary->path();
   }
+  RunFacts run = facts;
+  if (temporary || !reusable(store_path, args.input)) {
+    TileStoreOptions tiling;
+    tiling.tile_points = args.tile_points;
+    tiling.compress = args.compress;
+    tiling.progress = [&](std::uint64_t done, std::uint64_t total) {
+      progress.stage("tiling", total ? static_cast<double>(done) / static_cast<double>(total) : 1);
+    };
+    build_tile_store(args.input, store_path, tiling);
+  }
+  const TileStore store(store_path);
+  run.non_finite = store.input_report().non_finite;
+  if (store.point_count() == 0) {
+    throw Error(Exit::bad_input,
+                fmt::format("{}: no usable points ({} non-finite)", args.input, run.non_finite));
+  }
+  args.options.threads = args.threads;
   args.options.progress = [&](std::uint64_t done, std::uint64_t total) {
     progress.stage("meshing", static_cast<double>(done) / static_cast<double>(total));
   };
-  const MemoryTiles tiles(cloud, args.tile_points);
-  PipelineMesh mesh = mesh_tiles(tiles, args.options);
-  if (mesh.triangles.empty()) {
-    throw Error(Exit::bad_input,
-                fmt::format("{}: no triangle could be formed from {} points (too few, collinear "
-                            "or too sparse); nothing written",
-                            args.input, cloud.size()));
-  }
+  PipelineMesh mesh = mesh_tiles(store, args.options);
   progress.stage("writing", 1);
-  write_mesh(args.output, cloud.xyz, mesh.triangles, mesh_format_for(args.output, args.ascii));
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   progress.clear();
-
-  const MeshReport& r = mesh.report;
-  const double ktps = static_cast<double>(mesh.triangles.size()) / seconds / 1000.0;
-  MeshStats stats;
-  if (!args.no_stats) {
-    IndexedMesh indexed{std::move(cloud.xyz), std::move(mesh.triangles)};
-    stats = compute_stats(indexed);
-  }
-  if (args.json) {
-    fmt::print(
-        "{{\"input\":\"{}\",\"output\":\"{}\",\"points\":{},\"non_finite\":{},"
-        "\"duplicates_merged\":{},\"spacing\":{},\"seeds\":{},\"triangles\":{},"
-        "\"triangles_removed\":{},\"seconds\":{:.3f},\"seconds_grid\":{:.3f},"
-        "\"seconds_grow\":{:.3f},\"seconds_cleanup\":{:.3f},\"ktriangles_per_second\":{:.1f},"
-        "\"peak_rss_mb\":{:.1f},\"tiles\":{},\"triangles_stitched\":{},\"seconds_stitch\":{:.3f}",
-        args.input, args.output, r.points, read_report.non_finite, r.duplicates_merged, r.spacing,
-        r.seeds, r.triangles_grown - r.triangles_removed, r.triangles_removed, seconds,
-        r.seconds_grid, r.seconds_grow, r.seconds_cleanup, ktps, peak_rss_mb(), mesh.tiles,
-        mesh.triangles_stitched, mesh.seconds_stitch);
-    if (!args.no_stats) fmt::print(",\"stats\":{}", stats_to_json(stats));
-    fmt::print("}}\n");
-    return;
-  }
-  if (args.quiet) return;
-  fmt::print(
-      stderr, "{}: {} points -> {} triangles in {:.2f} s ({:.0f} k triangles/s), peak {:.0f} MB",
-      args.output, r.points, r.triangles_grown - r.triangles_removed, seconds, ktps, peak_rss_mb());
-  if (!args.no_stats) {
-    fmt::print(stderr,
-               "; non-manifold edges {}, non-manifold vertices {}, orientation conflicts {}, "
-               "boundary edges {}, holes {}",
-               stats.non_manifold_edges, stats.non_manifold_vertices, stats.orientation_conflicts,
-               stats.boundary_edges, stats.holes);
-  }
-  fmt::print(stderr, "\n");
+  write_and_report(mesh, args.out, run);
 }
 
 }  // namespace
+
+void add_mesh_options(CLI::App& cmd, PipelineOptions& options) {
+  cmd.add_option("--radius-steps", options.mesh.radius_steps,
+                 "Search radius levels, in edge lengths, increasing (default 1 1.5 2 3); "
+                 "more levels close more gaps in sparse regions, at some cost in speed")
+      ->expected(1, 16);
+  cmd.add_option("--flatness-levels", options.mesh.flatness_levels,
+                 "Flatness levels m of the priority queue (default 4); more levels mesh flat "
+                 "regions first more strictly")
+      ->check(CLI::Range(1, 64));
+  cmd.add_option("--max-fold", options.mesh.max_fold_deg,
+                 "Largest angle in degrees between neighbouring triangle normals (default 135); "
+                 "lower it on noisy scans to avoid folds, raise it for very sharp edges")
+      ->check(CLI::Range(10.0, 179.0));
+  cmd.add_option("--max-radius", options.mesh.max_radius,
+                 "Largest search ball, in sampling spacings (default 6); larger bridges wider "
+                 "gaps and scan borders, at a cost in speed on sparse or noisy regions")
+      ->check(CLI::Range(1.0, 1000.0));
+  cmd.add_flag(
+      "--no-orient", [&options](std::int64_t) { options.mesh.orient = false; },
+      "Keep each component's seed orientation instead of facing closed ones outward");
+}
+
+void add_output_options(CLI::App& cmd, OutputArgs& out) {
+  cmd.add_option("-o,--output", out.output,
+                 "Mesh to write: .stl (binary; --ascii for ASCII) or .ply (indexed binary)")
+      ->required();
+  cmd.add_flag("--ascii", out.ascii, "Write ASCII STL instead of binary");
+  cmd.add_flag("-q,--quiet", out.quiet, "Print nothing on success");
+  cmd.add_flag("--json", out.json, "Print the summary as one JSON object on stdout");
+  cmd.add_flag("--no-stats", out.no_stats, "Skip measuring the mesh's defects");
+}
 
 void add_mesh_command(CLI::App& app) {
   auto args = std::make_shared<MeshArgs>();
@@ -127,38 +117,18 @@ void add_mesh_command(CLI::App& app) {
       "mesh", "Reconstruct a triangle mesh from a point cloud (PLY, XYZ/PTS) with G2S");
   cmd->add_option("input", args->input, "Point cloud: PLY (ascii/binary) or text XYZ/PTS")
       ->required();
-  cmd->add_option("-o,--output", args->output,
-                  "Mesh to write: .stl (binary; --ascii for ASCII) or .ply (indexed binary)")
-      ->required();
+  add_output_options(*cmd, args->out);
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")
       ->check(CLI::NonNegativeNumber);
-  cmd->add_flag("--ascii", args->ascii, "Write ASCII STL instead of binary");
-  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
-  cmd->add_flag("--json", args->json, "Print the summary as one JSON object on stdout");
-  cmd->add_flag("--no-stats", args->no_stats, "Skip measuring the mesh's defects");
   cmd->add_option("--tile-points", args->tile_points,
-                  "Largest number of points in a tile (default 1048576): clouds are cut into "
+                  "Largest number of points in a tile (default 1048576): the cloud is cut into "
                   "tiles grown in parallel and stitched at the seams")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--radius-steps", args->options.mesh.radius_steps,
-                  "Search radius levels, in edge lengths, increasing (default 1 1.5 2 3); "
-                  "more levels close more gaps in sparse regions, at some cost in speed")
-      ->expected(1, 16);
-  cmd->add_option("--flatness-levels", args->options.mesh.flatness_levels,
-                  "Flatness levels m of the priority queue (default 4); more levels mesh flat "
-                  "regions first more strictly")
-      ->check(CLI::Range(1, 64));
-  cmd->add_option("--max-fold", args->options.mesh.max_fold_deg,
-                  "Largest angle in degrees between neighbouring triangle normals (default 135); "
-                  "lower it on noisy scans to avoid folds, raise it for very sharp edges")
-      ->check(CLI::Range(10.0, 179.0));
-  cmd->add_option("--max-radius", args->options.mesh.max_radius,
-                  "Largest search ball, in sampling spacings (default 6); larger bridges wider "
-                  "gaps and scan borders, at a cost in speed on sparse or noisy regions")
-      ->check(CLI::Range(1.0, 1000.0));
-  cmd->add_flag(
-      "--no-orient", [args](std::int64_t) { args->options.mesh.orient = false; },
-      "Keep each component's seed orientation instead of facing closed ones outward");
+  cmd->add_option("--keep-store", args->keep_store,
+                  "Keep the tile store at this path (reused by the next run while it is newer "
+                  "than the input) instead of a temporary beside the output");
+  cmd->add_flag("--compress", args->compress, "zstd-compress the tile store");
+  add_mesh_options(*cmd, args->options);
   cmd->callback([args] { run_mesh(*args); });
 }
 

@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "g2s 0.1.0");
   g2s::cli::add_mesh_command(app);
+  g2s::cli::add_stage_commands(app);
   g2s::cli::add_stats_command(app);
   g2s::cli::add_synth_command(app);
   g2s::cli::add_tile_commands(app);

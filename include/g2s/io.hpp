@@ -50,6 +50,21 @@ MeshFormat mesh_format_for(const std::filesystem::path& path, bool ascii_stl);
 // with Exit::interrupted (130). For programs; a library user may keep its own handlers.
 void install_interrupt_cleanup();
 
+// A file that exists only while a run needs it (the temporary tile store of `g2s mesh`):
+// removed when destroyed, and by the interrupt handler.
+class TemporaryPath {
+ public:
+  explicit TemporaryPath(std::filesystem::path path);
+  ~TemporaryPath();
+  TemporaryPath(const TemporaryPath&) = delete;
+  TemporaryPath& operator=(const TemporaryPath&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+  int registry_slot_ = -1;
+};
+
 // A file that appears at its target path only when complete: writes go through a 1 MiB buffer
 // to a temporary ".NAME.tmp-<pid>-<n>" in the same folder; write_at patches bytes already
 // written (flushed or still buffered); commit() flushes, closes (checking the result; no fsync)

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <span>
 #include <vector>
@@ -14,17 +15,6 @@
 #include "g2s/tile_store.hpp"
 
 namespace g2s {
-
-// Where the pipeline's points come from: the tile store, or tiles cut in memory.
-class TileSource {
- public:
-  virtual ~TileSource() = default;
-  virtual std::span<const TileInfo> tiles() const = 0;
-  virtual TilePoints load(std::size_t tile) const = 0;
-  // At least the points within `distance` of the tile box's boundary (more is allowed).
-  virtual TilePoints load_border(std::size_t tile, double distance) const = 0;
-  std::uint64_t point_count() const;
-};
 
 // A cloud cut into tiles in memory: by a k-d split at medians until no tile holds more than
 // tile_points, or by given boxes (which must partition the cloud's bounding box; tests use them
@@ -85,6 +75,17 @@ struct PipelineMesh {
 // components. growths[i] is grow_tile(source, i, options).
 PipelineMesh stitch_tiles(const TileSource& source, std::vector<TileGrowth> growths,
                           const PipelineOptions& options);
+
+// The tile store's identity for growth files: a hash of its tile table.
+std::uint64_t source_fingerprint(const TileSource& source);
+
+// Growth files, for `g2s grow` and `g2s stitch` in separate processes: written atomically, read
+// back exactly; a file for another tile or store, a truncated or corrupt one throws
+// Error(bad_input) naming the file and the fault.
+void write_tile_growth(const std::filesystem::path& file, std::uint32_t tile,
+                       std::uint64_t fingerprint, const TileGrowth& growth);
+TileGrowth read_tile_growth(const std::filesystem::path& file, std::uint32_t tile,
+                            std::uint64_t fingerprint);
 
 // All stages in one process: grow_tile over every tile as TBB tasks, then stitch_tiles.
 PipelineMesh mesh_tiles(const TileSource& source, const PipelineOptions& options);

@@ -70,10 +70,22 @@ struct TilePoints {
   std::size_t size() const { return ids.size(); }
 };
 
+// Where the pipeline's points come from (include/g2s/pipeline.hpp): a tile store, or tiles cut
+// in memory (MemoryTiles).
+class TileSource {
+ public:
+  virtual ~TileSource() = default;
+  virtual std::span<const TileInfo> tiles() const = 0;
+  virtual TilePoints load(std::size_t tile) const = 0;
+  // At least the points within `distance` of the tile box's boundary (more is allowed).
+  virtual TilePoints load_border(std::size_t tile, double distance) const = 0;
+  std::uint64_t point_count() const;  // points in all tiles
+};
+
 // A store opened for reading: the header and table are validated on open; a block's checksum
 // is checked each time it is loaded. Any corruption, truncation or version mismatch throws
 // Error(bad_input, "<store>: ...") naming what is wrong. Safe to load from several threads.
-class TileStore {
+class TileStore final : public TileSource {
  public:
   explicit TileStore(const std::filesystem::path& store);
   ~TileStore();
@@ -81,17 +93,16 @@ class TileStore {
   TileStore& operator=(const TileStore&) = delete;
 
   const std::filesystem::path& path() const;
-  std::uint64_t point_count() const;  // points in all tiles
-  const TileBox& bounds() const;      // bounding box of all points
-  std::span<const TileInfo> tiles() const;
+  const TileBox& bounds() const;  // bounding box of all points
+  std::span<const TileInfo> tiles() const override;
   const ReadReport& input_report() const;  // as build_tile_store saw the input
   bool compressed() const;                 // blocks are zstd frames (for g2s tile-info)
 
   // All points of a tile.
-  TilePoints load(std::size_t tile) const;
+  TilePoints load(std::size_t tile) const override;
   // The points of a tile within `distance` of its box's boundary (the halo its neighbours
   // need): a prefix of the block, so only that part is read (and decompressed).
-  TilePoints load_border(std::size_t tile, double distance) const;
+  TilePoints load_border(std::size_t tile, double distance) const override;
 
  private:
   struct Impl;

@@ -132,3 +132,17 @@ void AtomicFile::commit() {
 }
 
 }  // namespace g2s
+
+namespace g2s {
+
+TemporaryPath::TemporaryPath(std::filesystem::path path) : path_(std::move(path)) {
+  registry_slot_ = register_temporary(path_.c_str());
+}
+
+TemporaryPath::~TemporaryPath() {
+  std::error_code ignored;
+  std::filesystem::remove(path_, ignored);
+  unregister_temporary(registry_slot_);
+}
+
+}  // namespace g2s

@@ -259,9 +259,6 @@ TileStore::~TileStore() = default;
 const std::filesystem::path& TileStore::path() const {
   return impl_->path;
 }
-std::uint64_t TileStore::point_count() const {
-  return impl_->point_count;
-}
 const TileBox& TileStore::bounds() const {
   return impl_->bounds;
 }
