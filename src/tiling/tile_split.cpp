@@ -1,4 +1,4 @@
-// Adaptive k-d split (see tile_split.hpp): median cuts on a deterministic sample.
+// Adaptive k-d split (see tile_split.hpp): midpoint or quantile cuts on a deterministic sample.
 #include "tiling/tile_split.hpp"
 
 #include <algorithm>
