@@ -23,7 +23,7 @@ constexpr char kMagic[8] = {'G', '2', 'S', 'G', 'R', 'O', 'W', '\0'};
 constexpr std::uint32_t kVersion = 1;
 // magic, version, tile, fingerprint, triangles, groups, suspects, points, seeds, spacing,
 // seconds grid, seconds grow, payload checksum, header checksum.
-constexpr std::size_t kHeaderBytes = 8 + 4 + 4 + 8 * 12;
+constexpr std::size_t kHeaderBytes = 8 + 4 + 4 + 8 * 11;
 
 }  // namespace
 
