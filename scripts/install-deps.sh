@@ -3,7 +3,8 @@
 # or with sudo available). Safe to run again: only missing packages are installed.
 set -euo pipefail
 packages=(g++ cmake ninja-build pkg-config git time
-          libtbb-dev libzstd-dev libfmt-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev)
+          libtbb-dev libzstd-dev libfmt-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
+          parallel)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -51,9 +51,8 @@ void expect_clean(const g2s::MeshStats& s) {
 
 // Boundary edges and holes of the tiled mesh against the single-tile mesh: within 2% (plus a
 // small absolute allowance for clouds whose single-tile mesh is almost closed) for holes, and
-// for boundary edges within `boundary_ratio`: 1.02 where the seams zip cleanly; on the noisiest
-// scans, where two fronts meeting at every seam leave cracks, the ratio measured when this test
-// was written, so that it does not get worse (docs/pipeline.md).
+// for boundary edges within `boundary_ratio`: 1.02, except on the overlapping raw range scans,
+// where fronts meeting at the seams leave more cracks (measured 1.045; docs/pipeline.md).
 void expect_close_to(const g2s::MeshStats& tiled, const g2s::MeshStats& single,
                      double boundary_ratio) {
   EXPECT_LE(static_cast<double>(tiled.boundary_edges),
@@ -111,10 +110,10 @@ INSTANTIATE_TEST_SUITE_P(SharedData, RealScanTiled,
                          ::testing::Values(TiledCase{"closed-kitten", 1.02},
                                            TiledCase{"closed-bunny-zipper", 1.02},
                                            TiledCase{"open-bunny-scan-bun000", 1.02},
-                                           TiledCase{"raw-bunny", 1.13},
+                                           TiledCase{"raw-bunny", 1.06},
                                            TiledCase{"open-table-mug-stereo", 1.02},
-                                           TiledCase{"open-lion-photogrammetry", 1.12},
-                                           TiledCase{"open-autzen-lidar", 1.07}),
+                                           TiledCase{"open-lion-photogrammetry", 1.02},
+                                           TiledCase{"open-autzen-lidar", 1.02}),
                          [](const ::testing::TestParamInfo<TiledCase>& param) {
                            std::string name = param.param.name;
                            for (char& ch : name) {

@@ -22,8 +22,8 @@ namespace {
 constexpr char kMagic[8] = {'G', '2', 'S', 'G', 'R', 'O', 'W', '\0'};
 constexpr std::uint32_t kVersion = 1;
 // magic, version, tile, fingerprint, triangles, groups, suspects, points, seeds, spacing,
-// seconds grid, seconds grow, payload checksum, header checksum.
-constexpr std::size_t kHeaderBytes = 8 + 4 + 4 + 8 * 11;
+// payload checksum, header checksum. No timings: the same tile gives the same bytes.
+constexpr std::size_t kHeaderBytes = 8 + 4 + 4 + 8 * 9;
 
 }  // namespace
 
@@ -64,8 +64,6 @@ void write_tile_growth(const std::filesystem::path& file, std::uint32_t tile,
   h = io::put_le(h, growth.report.points);
   h = io::put_le(h, growth.report.seeds);
   h = io::put_le(h, growth.report.spacing);
-  h = io::put_le(h, growth.report.seconds_grid);
-  h = io::put_le(h, growth.report.seconds_grow);
   h = io::put_le(h, tiling::xxhash64(payload.data(), payload.size()));
   io::put_le(h, tiling::xxhash64(header, kHeaderBytes - 8));
 
@@ -114,7 +112,7 @@ TileGrowth read_tile_growth(const std::filesystem::path& file, std::uint32_t til
                     bytes.size() - kHeaderBytes, triangles, suspects));
   }
   const unsigned char* p = h + kHeaderBytes;
-  if (tiling::load_le<std::uint64_t>(h + 88) != tiling::xxhash64(p, bytes.size() - kHeaderBytes)) {
+  if (tiling::load_le<std::uint64_t>(h + 72) != tiling::xxhash64(p, bytes.size() - kHeaderBytes)) {
     throw fail("triangle checksum mismatch (the file is corrupt)");
   }
   TileGrowth g;
@@ -122,8 +120,6 @@ TileGrowth read_tile_growth(const std::filesystem::path& file, std::uint32_t til
   g.report.points = tiling::load_le<std::uint64_t>(h + 48);
   g.report.seeds = tiling::load_le<std::uint64_t>(h + 56);
   g.report.spacing = tiling::load_le<double>(h + 64);
-  g.report.seconds_grid = tiling::load_le<double>(h + 72);
-  g.report.seconds_grow = tiling::load_le<double>(h + 80);
   g.triangles.resize(triangles);
   for (Triangle& t : g.triangles) {
     for (Index& v : t) v = tiling::load_le<Index>(p), p += 4;

@@ -1,13 +1,13 @@
 // Tiles cut in memory (MemoryTiles): the TileSource for a cloud already read, and for tests that
-// place seams by hand. The k-d split mirrors the tile store's: longest axis, at the median
-// coordinate, until no tile holds more than its budget.
+// place seams by hand. The split is the tile store's (src/tiling/tile_split.hpp) on every point,
+// so a cloud small enough for the store to sample whole gets the same tiles either way.
 #include <algorithm>
-#include <numeric>
 
 #include "g2s/error.hpp"
 #include "g2s/pipeline.hpp"
-#include "grid/hash_grid.hpp"
 #include "pipeline/tile_geometry.hpp"
+#include "tiling/tile_spacing.hpp"
+#include "tiling/tile_split.hpp"
 
 namespace g2s {
 namespace {
@@ -25,33 +25,6 @@ TileBox bounding_box(const PointCloud& cloud) {
     }
   }
   return box;
-}
-
-void split(const PointCloud& cloud, TileBox box, std::span<Index> ids, std::uint64_t budget,
-           std::vector<TileBox>& boxes, std::vector<std::vector<Index>>& members) {
-  if (ids.size() > budget) {
-    int axis = 0;
-    for (int a = 1; a < 3; ++a) {
-      if (box.hi[a] - box.lo[a] > box.hi[axis] - box.lo[axis]) axis = a;
-    }
-    auto coord = [&](Index i) { return cloud.xyz[3 * std::size_t{i} + axis]; };
-    auto mid = ids.begin() + static_cast<long>(ids.size() / 2);
-    std::nth_element(ids.begin(), mid, ids.end(),
-                     [&](Index a, Index b) { return coord(a) < coord(b); });
-    const double at = coord(*mid);
-    const auto cut = std::partition(ids.begin(), ids.end(), [&](Index i) { return coord(i) < at; });
-    if (cut != ids.begin() && cut != ids.end()) {
-      TileBox low = box, high = box;
-      low.hi[axis] = at;
-      high.lo[axis] = at;
-      split(cloud, low, {ids.begin(), cut}, budget, boxes, members);
-      split(cloud, high, {cut, ids.end()}, budget, boxes, members);
-      return;
-    }
-  }
-  boxes.push_back(box);
-  members.emplace_back(ids.begin(), ids.end());
-  std::sort(members.back().begin(), members.back().end());
 }
 
 // Owner of a point among boxes that partition the bounding box: half-open, except on the
@@ -74,12 +47,24 @@ std::uint64_t TileSource::point_count() const {
 
 MemoryTiles::MemoryTiles(const PointCloud& cloud, std::uint64_t tile_points) : cloud_(cloud) {
   if (cloud.size() > kNoIndex) throw Error(Exit::bad_input, "cloud has more than 2^32-1 points");
-  std::vector<Index> ids(cloud.size());
-  std::iota(ids.begin(), ids.end(), Index{0});
-  std::vector<TileBox> boxes;
-  std::vector<std::vector<Index>> members;
-  split(cloud, bounding_box(cloud), ids, std::max<std::uint64_t>(tile_points, 1), boxes, members);
-  for (const TileBox& box : boxes) info_.push_back({box, 0, 0.0});
+  // The tile store's split, on every point (its exact case).
+  tiling::PointSample sample(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) sample.add(&cloud.xyz[3 * i], i);
+  tiling::TileTree tree(bounding_box(cloud));
+  if (cloud.size() > 0) {
+    tree.split(0, sample, 1.0, static_cast<double>(std::max<std::uint64_t>(tile_points, 1)));
+  }
+  const std::vector<std::uint32_t> leaves =
+      cloud.size() > 0 ? tree.leaves() : std::vector<std::uint32_t>{};
+  std::vector<std::uint32_t> tile_of_node(tree.node_count(), kNoIndex);
+  for (std::uint32_t t = 0; t < leaves.size(); ++t) {
+    tile_of_node[leaves[t]] = t;
+    info_.push_back({tree.box(leaves[t]), 0, 0.0});
+  }
+  std::vector<std::vector<Index>> members(leaves.size());
+  for (Index i = 0; i < cloud.size(); ++i) {
+    members[tile_of_node[tree.leaf_of(&cloud.xyz[3 * std::size_t{i}])]].push_back(i);
+  }
   finish(std::move(members));
 }
 
@@ -101,12 +86,7 @@ void MemoryTiles::finish(std::vector<std::vector<Index>> members) {
   members_ = std::move(members);
   for (std::size_t t = 0; t < info_.size(); ++t) {
     info_[t].points = members_[t].size();
-    const TilePoints points = load(t);
-    std::vector<float> local(points.xyz.size());
-    for (std::size_t k = 0; k < local.size(); ++k) {
-      local[k] = static_cast<float>(points.xyz[k] - info_[t].box.lo[k % 3]);
-    }
-    info_[t].spacing = points.size() < 2 ? 0.0 : HashGrid(local, points.ids).spacing();
+    info_[t].spacing = tiling::estimate_tile_spacing(load(t).xyz);
   }
 }
 

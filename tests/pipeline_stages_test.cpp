@@ -1,0 +1,228 @@
+// The pipeline's stages as separate processes (g2s tile, grow, stitch), as GNU parallel runs
+// them, give the same bytes as g2s mesh, with any thread count; growth files refuse to be
+// stitched when truncated, corrupt or from another store; each triangle is kept by one tile
+// only; seams placed through sharp edges, a thin plate and a hole close cleanly.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <set>
+#include <string>
+
+#include "g2s/error.hpp"
+#include "g2s/io.hpp"
+#include "g2s/pipeline.hpp"
+#include "g2s/stats.hpp"
+#include "g2s/synth.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+class Stages : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("g2s-stages-" + std::to_string(::getpid()) + "-" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    g2s::SynthOptions o;
+    o.shape = g2s::SynthShape::torus;
+    o.points = 30000;
+    o.noise = 0.2;
+    cloud_ = (dir_ / "torus.ply").string();
+    g2s::write_synthetic_cloud(cloud_, o);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Runs the CLI in the test folder; returns its exit code, stderr in `err`.
+  int run(const std::string& args, std::string* err = nullptr) const {
+    const fs::path log = dir_ / "stderr.txt";
+    const std::string command = "cd \"" + dir_.string() + "\" && \"" + G2S_CLI_PATH + "\" " + args +
+                                " > /dev/null 2> \"" + log.string() + "\"";
+    const int status = std::system(command.c_str());
+    if (err) *err = read(log);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+  static std::string read(const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  }
+
+  fs::path dir_;
+  std::string cloud_;
+};
+
+TEST_F(Stages, SeparateProcessesGiveTheBytesOfOneMeshRunForAnyThreadCount) {
+  ASSERT_EQ(run("mesh torus.ply -o one.stl --tile-points 2000 --threads 1 -q"), 0);
+  ASSERT_EQ(run("mesh torus.ply -o two.stl --tile-points 2000 --threads 2 -q"), 0);
+  ASSERT_EQ(run("tile torus.ply s.store --tile-points 2000 -q"), 0);
+  const g2s::TileStore store(dir_ / "s.store");
+  const std::size_t tiles = store.tiles().size();
+  ASSERT_GE(tiles, 10u);
+  const std::size_t half = tiles / 2;
+  ASSERT_EQ(run("grow s.store --tiles 0-" + std::to_string(half - 1) + " --threads 1 -q"), 0);
+  ASSERT_EQ(
+      run("grow s.store --tiles " + std::to_string(half) + "-" + std::to_string(tiles - 1) + " -q"),
+      0);
+  ASSERT_EQ(run("stitch s.store -o staged.stl -q"), 0);
+  const std::string one = read(dir_ / "one.stl");
+  ASSERT_GT(one.size(), 84u);
+  EXPECT_TRUE(one == read(dir_ / "two.stl")) << "1 and 2 threads differ";
+  EXPECT_TRUE(one == read(dir_ / "staged.stl")) << "separate stages differ from g2s mesh";
+  // Growing again finds every tile done: nothing changes.
+  std::string err;
+  ASSERT_EQ(run("grow s.store", &err), 0);
+  EXPECT_NE(err.find("(" + std::to_string(tiles) + " already there)"), std::string::npos) << err;
+}
+
+TEST_F(Stages, GnuParallelDrivesTheGrowStage) {
+  if (std::system("command -v parallel > /dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "GNU parallel is not installed (scripts/install-deps.sh installs it)";
+  }
+  ASSERT_EQ(run("mesh torus.ply -o one.stl --tile-points 2000 -q"), 0);
+  ASSERT_EQ(run("tile torus.ply s.store --tile-points 2000 -q"), 0);
+  const std::size_t tiles = g2s::TileStore(dir_ / "s.store").tiles().size();
+  // One job per tile, up to 4 at once, exactly as docs/pipeline.md shows.
+  const std::string command = "cd \"" + dir_.string() + "\" && seq 0 " + std::to_string(tiles - 1) +
+                              " | parallel -j4 --halt now,fail=1 \"" + G2S_CLI_PATH +
+                              "\" grow s.store --tiles {} --threads 1 -q";
+  ASSERT_EQ(std::system(command.c_str()), 0);
+  ASSERT_EQ(run("stitch s.store -o parallel.stl -q"), 0);
+  EXPECT_TRUE(read(dir_ / "one.stl") == read(dir_ / "parallel.stl"))
+      << "GNU parallel stages differ from g2s mesh";
+}
+
+TEST_F(Stages, StitchRefusesMissingCorruptTruncatedOrForeignGrowths) {
+  ASSERT_EQ(run("tile torus.ply s.store --tile-points 4000 -q"), 0);
+  std::string err;
+  EXPECT_EQ(run("stitch s.store -o out.stl", &err), 3);
+  EXPECT_NE(err.find("was the tile grown"), std::string::npos) << err;
+  ASSERT_EQ(run("grow s.store -q"), 0);
+  const fs::path growth = dir_ / "s.store.grown" / "tile-000001.g2sgrow";
+  const std::string good = read(growth);
+  auto write = [&](const std::string& bytes) {
+    std::ofstream(growth, std::ios::binary | std::ios::trunc) << bytes;
+  };
+  std::string bad = good;
+  bad[bad.size() / 2] ^= 0x10;
+  write(bad);
+  EXPECT_EQ(run("stitch s.store -o out.stl", &err), 3);
+  EXPECT_NE(err.find("triangle checksum mismatch"), std::string::npos) << err;
+  bad = good;
+  bad[20] ^= 0x01;  // inside the header
+  write(bad);
+  EXPECT_EQ(run("stitch s.store -o out.stl", &err), 3);
+  EXPECT_NE(err.find("header checksum mismatch"), std::string::npos) << err;
+  write(good.substr(0, good.size() - 7));
+  EXPECT_EQ(run("stitch s.store -o out.stl", &err), 3);
+  EXPECT_NE(err.find("truncated"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(dir_ / "out.stl"));
+  // Growths of another store (other tiles) are refused, and the grow stage redoes them.
+  write(good);
+  ASSERT_EQ(run("tile torus.ply other.store --tile-points 3000 -q"), 0);
+  EXPECT_EQ(run("stitch other.store --grown s.store.grown -o out.stl", &err), 3);
+  EXPECT_NE(err.find("different tile store"), std::string::npos) << err;
+  write(good.substr(0, 50));
+  ASSERT_EQ(run("grow s.store", &err), 0);
+  EXPECT_TRUE(read(growth) == good) << "a tile grown again gives other bytes";
+}
+
+// Tile growths: every kept triangle has all its corners in its own tile, so no triangle is kept
+// by two tiles, and nothing is lost: with the seams stitched the torus is closed.
+TEST(PipelineOwnership, EachTriangleIsKeptByOneTileOnly) {
+  g2s::SynthOptions o;
+  o.shape = g2s::SynthShape::torus;
+  o.points = 20000;
+  const g2s::PointCloud cloud = g2s::make_synthetic_cloud(o);
+  const g2s::MemoryTiles tiles(cloud, 1500);
+  ASSERT_GE(tiles.tiles().size(), 16u);
+  std::vector<std::size_t> tile_of(cloud.size());
+  for (std::size_t t = 0; t < tiles.tiles().size(); ++t) {
+    for (g2s::Index id : tiles.load(t).ids) tile_of[id] = t;
+  }
+  std::set<std::array<g2s::Index, 3>> seen;
+  for (std::size_t t = 0; t < tiles.tiles().size(); ++t) {
+    const g2s::TileGrowth g = g2s::grow_tile(tiles, t, {});
+    EXPECT_GT(g.triangles.size(), 0u);
+    for (g2s::Triangle tri : g.triangles) {
+      for (g2s::Index v : tri) ASSERT_EQ(tile_of[v], t);
+      std::sort(tri.begin(), tri.end());
+      EXPECT_TRUE(seen.insert(tri).second);
+    }
+  }
+}
+
+// A seam placed on purpose: the cloud cut by one plane into two tiles.
+g2s::MeshStats mesh_with_cut(const g2s::PointCloud& cloud, int axis, double at) {
+  g2s::TileBox all;
+  for (int a = 0; a < 3; ++a) {
+    all.lo[a] = all.hi[a] = cloud.xyz[a];
+  }
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    for (int a = 0; a < 3; ++a) {
+      all.lo[a] = std::min(all.lo[a], cloud.xyz[3 * i + a]);
+      all.hi[a] = std::max(all.hi[a], cloud.xyz[3 * i + a]);
+    }
+  }
+  g2s::TileBox low = all, high = all;
+  low.hi[axis] = at;
+  high.lo[axis] = at;
+  const g2s::MemoryTiles tiles(cloud, std::vector<g2s::TileBox>{low, high});
+  const g2s::PipelineMesh mesh = g2s::mesh_tiles(tiles, {});
+  return g2s::compute_stats(g2s::IndexedMesh{cloud.xyz, mesh.triangles}, &cloud);
+}
+
+void expect_seam_closes(const g2s::PointCloud& cloud, int axis, double at) {
+  const g2s::MemoryTiles one(cloud, cloud.size());
+  const g2s::PipelineMesh single = g2s::mesh_tiles(one, {});
+  const g2s::MeshStats s1 = g2s::compute_stats(g2s::IndexedMesh{cloud.xyz, single.triangles});
+  const g2s::MeshStats s = mesh_with_cut(cloud, axis, at);
+  EXPECT_EQ(s.non_manifold_edges, 0u);
+  EXPECT_EQ(s.non_manifold_vertices, 0u);
+  EXPECT_EQ(s.orientation_conflicts, 0u);
+  EXPECT_EQ(s.duplicate_triangles, 0u);
+  EXPECT_LE(static_cast<double>(s.boundary_edges),
+            static_cast<double>(s1.boundary_edges) * 1.02 + 6)
+      << "seam at axis " << axis << " = " << at;
+  EXPECT_LE(s.holes, s1.holes + 1);
+}
+
+TEST(PipelineSeams, ThroughTheSharpEdgesOfACube) {
+  g2s::SynthOptions o;
+  o.shape = g2s::SynthShape::cube;  // edge 2, centred at the origin
+  o.points = 30000;
+  const g2s::PointCloud cloud = g2s::make_synthetic_cloud(o);
+  expect_seam_closes(cloud, 0, 0.999);  // a hair inside the face x = 1: along its sharp edges
+  expect_seam_closes(cloud, 2, 0.0);    // across four faces
+}
+
+TEST(PipelineSeams, ThroughAThinPlate) {
+  g2s::SynthOptions o;
+  o.shape = g2s::SynthShape::plate;  // 2 x 2 x 0.05, closed
+  o.points = 30000;
+  const g2s::PointCloud cloud = g2s::make_synthetic_cloud(o);
+  expect_seam_closes(cloud, 2, 0.0);  // between the two sheets, parallel to them
+  expect_seam_closes(cloud, 0, 0.1);  // across both sheets and the thin rim
+}
+
+TEST(PipelineSeams, ThroughAHole) {
+  g2s::SynthOptions o;
+  o.shape = g2s::SynthShape::sphere;
+  o.points = 30000;
+  g2s::PointCloud sphere = g2s::make_synthetic_cloud(o);
+  g2s::PointCloud holed;  // a round hole of radius 0.3 around the +x pole
+  for (std::size_t i = 0; i < sphere.size(); ++i) {
+    const double* p = &sphere.xyz[3 * i];
+    if (p[0] > 0 && std::hypot(p[1], p[2]) < 0.3) continue;
+    holed.xyz.insert(holed.xyz.end(), p, p + 3);
+  }
+  expect_seam_closes(holed, 1, 0.0);  // the seam crosses the hole
+}
+
+}  // namespace
