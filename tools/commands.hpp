@@ -9,5 +9,6 @@ namespace g2s::cli {
 void add_mesh_command(CLI::App& app);
 void add_stats_command(CLI::App& app);
 void add_synth_command(CLI::App& app);
+void add_render_command(CLI::App& app);
 
 }  // namespace g2s::cli
