@@ -271,6 +271,14 @@ TEST(Render, BoundaryEdgesAreRedAndNonManifoldEdgesMagenta) {
   EXPECT_EQ(report.non_manifold_edges, 1u);
   EXPECT_EQ(report.boundary_edges, 6u);
   EXPECT_GT(c.magenta, 10);
+  // Edges can be drawn thinner, or not at all.
+  options.edge_width = 1;
+  const Census thin = census(render_and_read_back(square, options));
+  EXPECT_GT(thin.red, 50);
+  EXPECT_LT(thin.red, c.red);
+  options.edge_width = 0;
+  const Census none = census(render_and_read_back(square, options));
+  EXPECT_EQ(none.red + none.magenta, 0);
 }
 
 // A boundary edge hidden behind the surface is not drawn: a square with a far-away twin behind
@@ -310,6 +318,9 @@ TEST(Render, RejectsBadOptionsAndIndices) {
   options.elevation_deg = 90;
   EXPECT_EQ(code(tetrahedron(), options), static_cast<int>(g2s::Exit::usage));
   options.elevation_deg = 0;
+  options.edge_width = 9;
+  EXPECT_EQ(code(tetrahedron(), options), static_cast<int>(g2s::Exit::usage));
+  options.edge_width = 2;
   options.up_axis = 3;
   EXPECT_EQ(code(tetrahedron(), options), static_cast<int>(g2s::Exit::usage));
   // An empty mesh is a white picture.

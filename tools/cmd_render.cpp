@@ -1,6 +1,7 @@
-// `g2s render MESH -o OUT.png [--size WxH] [--view AZIMUTH,ELEVATION] [--up x|y|z]`: a picture of
-// a mesh for people (docs, reports): flat-shaded, outside blue and inside yellow, boundary edges
-// red, non-manifold edges magenta. Unreadable meshes exit 3, bad options 2.
+// `g2s render MESH -o OUT.png [--size WxH] [--view AZIMUTH,ELEVATION] [--up x|y|z]
+// [--edge-width N]`: a picture of a mesh for people (docs, reports): flat-shaded, outside blue and
+// inside yellow, boundary edges red, non-manifold edges magenta. Unreadable meshes exit 3, bad
+// options 2.
 #include <fmt/core.h>
 
 #include <charconv>
@@ -24,6 +25,7 @@ struct RenderArgs {
   std::string size = "800x600";
   std::string view = "30,20";
   std::string up = "z";
+  int edge_width = 2;
 };
 
 // "A<sep>B" -> two numbers; false when the text is anything else.
@@ -47,6 +49,7 @@ void run_render(const RenderArgs& args) {
         Exit::usage,
         fmt::format("render: --view expects AZIMUTH,ELEVATION in degrees, not '{}'", args.view));
   options.up_axis = args.up[0] - 'x';
+  options.edge_width = args.edge_width;
   const IndexedMesh mesh = read_mesh(args.mesh);
   RenderReport report;
   const Image image = render_mesh(mesh, options, &report);
@@ -75,6 +78,10 @@ void add_render_command(CLI::App& app) {
                   "Camera direction in degrees: azimuth about the up axis (0: from the next axis,\n"
                   "up z: from +x, up y: from +z, up x: from +y), elevation in (-90, 90)")
       ->capture_default_str();
+  cmd->add_option("--edge-width", args->edge_width,
+                  "Width of the boundary and non-manifold edges in pixels (0: not drawn)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 8));
   cmd->add_option("--up", args->up, "The axis that points up in the picture")
       ->capture_default_str()
       ->check(CLI::IsMember({"x", "y", "z"}));

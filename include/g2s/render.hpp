@@ -25,6 +25,9 @@ struct RenderOptions {
   double azimuth_deg = 30.0;
   double elevation_deg = 20.0;
   int up_axis = 2;  // 0 x, 1 y, 2 z
+  // Boundary and non-manifold edges are drawn this many pixels wide (0 .. 8; 0: not drawn).
+  // 1 keeps the surface visible where there are very many, as on merged raw scans.
+  int edge_width = 2;
 };
 
 // An RGB picture: width * height pixels, 3 bytes each, rows top to bottom.

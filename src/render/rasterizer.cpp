@@ -19,6 +19,7 @@ namespace g2s {
 namespace {
 
 constexpr int kMaxSide = 16384;
+constexpr int kMaxEdgeWidth = 8;
 constexpr double kFill = 0.94;  // share of the frame the mesh's projection spans
 constexpr std::array<double, 3> kOutside{110, 150, 220};          // blue
 constexpr std::array<double, 3> kInside{230, 190, 80};            // yellow
@@ -61,6 +62,9 @@ void check_options(const RenderOptions& o) {
                 fmt::format("render: view needs a finite azimuth and an elevation in (-90, 90), "
                             "not {},{}",
                             o.azimuth_deg, o.elevation_deg));
+  if (o.edge_width < 0 || o.edge_width > kMaxEdgeWidth)
+    throw Error(Exit::usage, fmt::format("render: edge width must be 0..{} pixels, not {}",
+                                         kMaxEdgeWidth, o.edge_width));
   if (o.up_axis < 0 || o.up_axis > 2)
     throw Error(Exit::usage, fmt::format("render: up axis must be 0, 1 or 2, not {}", o.up_axis));
 }
@@ -120,16 +124,18 @@ class Canvas {
     }
   }
 
-  // Draws the segment a-b two pixels wide where it lies no more than slack behind the surface.
-  void line(const Vec3& a, const Vec3& b, double slack, const std::array<std::uint8_t, 3>& rgb) {
+  // Draws the segment a-b `width` pixels wide where it lies no more than slack behind the
+  // surface.
+  void line(const Vec3& a, const Vec3& b, int width, double slack,
+            const std::array<std::uint8_t, 3>& rgb) {
     const int steps =
         1 + static_cast<int>(std::ceil(std::max(std::abs(b.x - a.x), std::abs(b.y - a.y))));
     for (int s = 0; s <= steps; ++s) {
       const double t = static_cast<double>(s) / steps;
       const Vec3 p = a + (b - a) * t;
       const int x = static_cast<int>(std::floor(p.x)), y = static_cast<int>(std::floor(p.y));
-      for (int dy = 0; dy < 2; ++dy)
-        for (int dx = 0; dx < 2; ++dx) plot(x + dx, y + dy, p.z, slack, rgb, false);
+      for (int dy = 0; dy < width; ++dy)
+        for (int dx = 0; dx < width; ++dx) plot(x + dx, y + dy, p.z, slack, rgb, false);
     }
   }
 
@@ -224,8 +230,10 @@ Image render_mesh(const IndexedMesh& mesh, const RenderOptions& options, RenderR
   counts.non_manifold_edges = non_manifold.size();
   // An edge shows when it is within two pixels' depth of the nearest surface there.
   const double slack = 2.0 / scale;
-  for (const auto& e : boundary) canvas.line(screen(e[0]), screen(e[1]), slack, kBoundary);
-  for (const auto& e : non_manifold) canvas.line(screen(e[0]), screen(e[1]), slack, kNonManifold);
+  const int width = options.edge_width;
+  for (const auto& e : boundary) canvas.line(screen(e[0]), screen(e[1]), width, slack, kBoundary);
+  for (const auto& e : non_manifold)
+    canvas.line(screen(e[0]), screen(e[1]), width, slack, kNonManifold);
   if (report) *report = counts;
   return canvas.take();
 }
