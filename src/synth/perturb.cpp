@@ -1,7 +1,6 @@
 // Noise and outliers on a measured cloud (include/g2s/synth.hpp: mean_spacing, perturb_cloud),
 // to repeat the paper's experiments on the Stanford Bunny (Di Angelo & Giaccari 2011, §5, Tables
 // 3 and 4) with sigma in units of the cloud's own spacing, as the synthetic shapes have it.
-#include <fmt/core.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
