@@ -226,7 +226,7 @@ surface, the closest to what the paper's tables count:
 
 Pictures: \`g2s render MESH --size $size --view=$view --up y\` (raw scans: \`--edge-width 1\`, as
 their boundary edges would hide the surface at 2 pixels); outside blue, inside yellow (seen
-through a hole, or where a patch faces inward), boundary edges red, non-manifold edges magenta
+through a hole, or where the surface folds back), boundary edges red, non-manifold edges magenta
 (there are none).
 
 ## The pictures
