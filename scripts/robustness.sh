@@ -144,9 +144,9 @@ $verdict
 
 ## What is measured
 The paper (Di Angelo & Giaccari 2011, §5) tests robustness on the Stanford Bunny twice: with
-Gaussian noise at three values of its standard deviation σ (its Table 3, Fig. 8) and with 5%, 10% and 20%
-outliers (its Table 4, Fig. 9), counting non-manifold vertices n_nmv, holes n_h and boundary
-edges n_be. We do the same on \`closed-bunny-zipper.ply\` (the 35,947 vertices of Stanford's
+Gaussian noise at three values of its standard deviation σ (its Table 3, Fig. 8) and with 5%,
+10% and 20% outliers (its Table 4, Fig. 9), counting non-manifold vertices n_nmv, holes n_h and
+boundary edges n_be. We do the same on \`closed-bunny-zipper.ply\` (the 35,947 vertices of Stanford's
 zippered bunny; see \`../shared/data/README.md\`), and mesh the ten merged raw range scans
 \`raw-bunny.ply\` as they are: real scanner noise, overlapping layers, no synthetic help.
 
