@@ -1,6 +1,8 @@
 // `g2s synth SHAPE --points N -o OUT.ply [--noise S] [--outliers F] [--seed K]`: writes an
 // evenly sampled analytic shape as binary PLY, for tests, the demo and benchmarks; streamed, so
-// 100M points need no more memory than 1M. Bad values exit 2 (CLI11 or g2s::Error(usage)).
+// 100M points need no more memory than 1M. `g2s synth --from CLOUD -o OUT.ply [--noise S]
+// [--outliers F] [--seed K]` perturbs a measured cloud the same way instead (the paper's noise
+// and outlier experiments). Bad values exit 2 (CLI11 or g2s::Error(usage)).
 #include <fmt/core.h>
 
 #include <charconv>
@@ -13,6 +15,7 @@
 
 #include "commands.hpp"
 #include "g2s/error.hpp"
+#include "g2s/io.hpp"
 #include "g2s/synth.hpp"
 
 namespace g2s::cli {
@@ -20,6 +23,7 @@ namespace {
 
 struct SynthArgs {
   std::string shape;
+  std::string from;
   std::uint64_t points = 0;
   std::string output;
   double noise = 0.0;
@@ -65,7 +69,39 @@ std::string expand_count(std::string& text) {
   return "";
 }
 
+// Reads CLOUD, adds the noise and outliers and writes float PLY (in memory: the spacing needs
+// every point).
+void run_perturb(const SynthArgs& args) {
+  PerturbOptions options;
+  options.noise = args.noise;
+  options.outliers = args.outliers;
+  options.seed = args.seed;
+  const auto start = std::chrono::steady_clock::now();
+  const PointCloud cloud = read_points(args.from);
+  PerturbReport report;
+  const PointCloud out = perturb_cloud(cloud, options, &report);
+  PlyPointWriter writer(args.output, out.size());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    writer.add(static_cast<float>(out.xyz[3 * i]), static_cast<float>(out.xyz[3 * i + 1]),
+               static_cast<float>(out.xyz[3 * i + 2]));
+  }
+  writer.finish();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  fmt::print(stderr,
+             "g2s synth: {} {} points + {} outliers, spacing {:.6g}, noise sigma {:.6g}, seed {}, "
+             "wrote {} in {:.2f} s\n",
+             args.from, cloud.size(), report.outliers, report.spacing, report.sigma, args.seed,
+             args.output, seconds);
+}
+
 void run_synth(const SynthArgs& args) {
+  if (!args.from.empty()) {
+    run_perturb(args);
+    return;
+  }
+  if (args.shape.empty() || args.points == 0)
+    throw Error(Exit::usage, "synth: give a SHAPE and --points, or --from CLOUD");
   const auto shape = synth_shape_from_name(args.shape);
   if (!shape) throw Error(Exit::usage, fmt::format("unknown shape '{}'", args.shape));
   SynthOptions options;
@@ -97,22 +133,28 @@ void add_synth_command(CLI::App& app) {
       "evenly like a good scan (one jittered point per near-square cell), with optional Gaussian\n"
       "noise and uniform outliers. Deterministic for a seed; streamed in bounded memory.\n"
       "Shapes: sphere (r 1), torus (R 1, r 0.35), cube (edge 2), plate (2 x 2 x 0.05, closed),\n"
-      "uneven (unit sphere, density 1:16 pole to pole), terrain (open height field over [0,1]^2).");
-  cmd->add_option("SHAPE", args->shape, "sphere, torus, cube, plate, uneven or terrain")
-      ->required()
-      ->check(CLI::IsMember({"sphere", "torus", "cube", "plate", "uneven", "terrain"}));
-  cmd->add_option("--points,-n", args->points,
-                  "Surface points, exactly (suffixes k, M, G: 500k, 2M)")
-      ->required()
-      ->transform(CLI::Validator(expand_count, "N[k|M|G]", "count"));
+      "uneven (unit sphere, density 1:16 pole to pole), terrain (open height field over [0,1]^2).\n"
+      "With --from CLOUD instead of SHAPE: the cloud's points (in their order) with the noise,\n"
+      "then the outliers in its bounding box; sigma is relative to its exact mean\n"
+      "nearest-neighbour spacing. Written as float, like the shapes.");
+  CLI::Option* shape =
+      cmd->add_option("SHAPE", args->shape, "sphere, torus, cube, plate, uneven or terrain")
+          ->check(CLI::IsMember({"sphere", "torus", "cube", "plate", "uneven", "terrain"}));
+  CLI::Option* points =
+      cmd->add_option("--points,-n", args->points,
+                      "Surface points, exactly (suffixes k, M, G: 500k, 2M); with SHAPE")
+          ->transform(CLI::Validator(expand_count, "N[k|M|G]", "count"));
+  cmd->add_option("--from", args->from, "Perturb this cloud (PLY, XYZ) instead of a SHAPE")
+      ->excludes(shape)
+      ->excludes(points);
   cmd->add_option("-o,--output", args->output, "Output file (binary PLY)")->required();
   cmd->add_option("--noise", args->noise,
                   "Gaussian noise sigma per coordinate, as a fraction of the mean spacing "
-                  "sqrt(area / points)")
+                  "(SHAPE: sqrt(area / points); --from: mean nearest-neighbour distance)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 100.0));
   cmd->add_option("--outliers", args->outliers,
-                  "Outliers, as a fraction of the points, uniform in the shape's bounding box")
+                  "Outliers, as a fraction of the points, uniform in the bounding box")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 100.0));
   cmd->add_option("--seed", args->seed, "Random seed")->capture_default_str();

@@ -14,6 +14,7 @@ void add_stage_commands(CLI::App& app);  // grow, stitch
 void add_stats_command(CLI::App& app);
 void add_synth_command(CLI::App& app);
 void add_tile_commands(CLI::App& app);  // tile and tile-info
+void add_render_command(CLI::App& app);
 
 // Options shared by the commands that mesh: G2S parameters, and where and how to write.
 void add_mesh_options(CLI::App& cmd, PipelineOptions& options);

@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   g2s::cli::add_stats_command(app);
   g2s::cli::add_synth_command(app);
   g2s::cli::add_tile_commands(app);
+  g2s::cli::add_render_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

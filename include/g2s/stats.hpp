@@ -47,6 +47,13 @@ struct MeshStats {
 // Throws Error(bad_input) when a triangle indexes a vertex past the end of mesh.xyz.
 MeshStats compute_stats(const IndexedMesh& mesh, const PointCloud* input_points = nullptr);
 
+// The triangles of the largest connected piece of mesh (most triangles; triangles sharing a
+// vertex index are connected; of equal pieces, the one whose first triangle comes first), in
+// input order, with all of mesh.xyz. Index-based: weld first (read_mesh does for STL) when
+// corners may repeat a position under different indices. Throws Error(bad_input) when a
+// triangle indexes a vertex past the end of mesh.xyz.
+IndexedMesh largest_component(const IndexedMesh& mesh);
+
 std::string stats_to_json(const MeshStats& stats);  // one JSON object, stable key order
 std::string stats_to_text(const MeshStats& stats);  // aligned "name  value" lines for people
 

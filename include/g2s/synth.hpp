@@ -63,4 +63,37 @@ PointCloud make_synthetic_cloud(const SynthOptions& options);
 // file is left at target).
 void write_synthetic_cloud(const std::filesystem::path& target, const SynthOptions& options);
 
+// Perturbing a measured cloud the way the paper perturbs the Stanford Bunny (its Tables 3 and 4):
+// the same Gaussian noise and box outliers as SynthOptions, drawn the same way (point i from the
+// counter-based stream of (seed, i)), but scaled to the cloud's own measured spacing.
+struct PerturbOptions {
+  // Gaussian sigma, as a fraction of mean_spacing(cloud): sigma * spacing is added independently
+  // to each of x, y and z of every input point (finite, >= 0).
+  double noise = 0.0;
+  // Outliers: round(outliers * n) extra points, uniform in the input's axis-aligned bounding box,
+  // appended after the n perturbed input points (0 .. 100).
+  double outliers = 0.0;
+  std::uint64_t seed = 1;
+};
+
+// What perturb_cloud did, for the CLI summary and the tests.
+struct PerturbReport {
+  double spacing = 0.0;        // mean_spacing of the input, in its units
+  double sigma = 0.0;          // noise * spacing, in the input's units
+  std::uint64_t outliers = 0;  // points appended
+};
+
+// Mean distance from each point to its nearest other point, exact (every point is queried, on
+// the mesher's hash grid, in a local frame around the bounding-box centre), as in
+// ../shared/data/README.md. Exact duplicates count once. Throws Error(bad_input) when the cloud
+// has fewer than two distinct points.
+double mean_spacing(const PointCloud& cloud);
+
+// The n input points, each moved by the noise, then the outliers: n + round(outliers * n) points
+// in double (no rounding to float). Deterministic for a seed; point i's noise does not depend on
+// the other points. Throws Error(usage) for options out of the ranges above, Error(bad_input)
+// for a cloud with fewer than two distinct points (no spacing, no box to fill).
+PointCloud perturb_cloud(const PointCloud& cloud, const PerturbOptions& options,
+                         PerturbReport* report = nullptr);
+
 }  // namespace g2s

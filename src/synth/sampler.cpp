@@ -9,6 +9,7 @@
 #include <numbers>
 
 #include "synth/counter_rng.hpp"
+#include "synth/noise.hpp"
 
 namespace g2s::synth {
 namespace {
@@ -334,21 +335,15 @@ void ShapeSampler::generate(std::uint64_t begin, std::uint64_t end, float* xyz) 
       const double s = (static_cast<double>(cell) + 0.5 + ju) / static_cast<double>(cells);
       double point[3] = {0.0, 0.0, 0.0};
       surface_point(*patch, row, s, 0.5 + jv, point);
-      if (sigma_ > 0.0) {
-        double n0, n1, n2, unused;
-        rng.normal_pair(n0, n1);
-        rng.normal_pair(n2, unused);
-        point[0] += sigma_ * n0;
-        point[1] += sigma_ * n1;
-        point[2] += sigma_ * n2;
-      }
+      if (sigma_ > 0.0) add_gaussian_noise(rng, sigma_, point);
       for (int a = 0; a < 3; ++a) xyz[a] = static_cast<float>(point[a]);
     }
   }
   for (; i < end; ++i, xyz += 3) {
     CounterRng rng(seed_, i);
-    for (int a = 0; a < 3; ++a)
-      xyz[a] = static_cast<float>(bounds_.lo[a] + rng.uniform() * (bounds_.hi[a] - bounds_.lo[a]));
+    double point[3];
+    uniform_in_box(rng, bounds_.lo, bounds_.hi, point);
+    for (int a = 0; a < 3; ++a) xyz[a] = static_cast<float>(point[a]);
   }
 }
 

@@ -14,6 +14,7 @@
 
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
+#include "synth/noise.hpp"
 #include "synth/sampler.hpp"
 
 namespace g2s {
@@ -30,18 +31,12 @@ constexpr std::array<std::pair<SynthShape, std::string_view>, 6> kNames{{
 
 // Far beyond any real use, and small enough that counts stay exact in double arithmetic.
 constexpr std::uint64_t kMaxPoints = std::uint64_t{1} << 40;
-constexpr double kMaxOutliers = 100.0;
 
 void check_options(const SynthOptions& options) {
   if (options.points == 0 || options.points > kMaxPoints)
     throw Error(Exit::usage, fmt::format("synthetic cloud: points must be in 1..{}, not {}",
                                          kMaxPoints, options.points));
-  if (!std::isfinite(options.noise) || options.noise < 0.0)
-    throw Error(Exit::usage, fmt::format("synthetic cloud: noise must be finite and >= 0, not {}",
-                                         options.noise));
-  if (!std::isfinite(options.outliers) || options.outliers < 0.0 || options.outliers > kMaxOutliers)
-    throw Error(Exit::usage, fmt::format("synthetic cloud: outliers must be in [0, {}], not {}",
-                                         kMaxOutliers, options.outliers));
+  synth::check_noise_and_outliers("synthetic cloud", options.noise, options.outliers);
 }
 
 // Fills xyz (3 floats per point) with points [begin, end) on all cores.
