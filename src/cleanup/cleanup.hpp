@@ -42,7 +42,7 @@ std::vector<std::array<Index, 2>> open_edges(const std::vector<Triangle>& triang
 std::uint64_t orient_components(std::vector<Triangle>& triangles, std::span<const Vec3f> positions,
                                 std::vector<std::array<Index, 2>>& open);
 
-// The same, finding the open edges itself.
+// The same, telling closed components from open ones without an edge map (an XOR of edge keys).
 std::uint64_t orient_components(std::vector<Triangle>& triangles, std::span<const Vec3f> positions);
 
 }  // namespace g2s

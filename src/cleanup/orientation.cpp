@@ -27,14 +27,24 @@ std::vector<std::array<Index, 2>> open_edges(const std::vector<Triangle>& triang
   return open;
 }
 
-std::uint64_t orient_components(std::vector<Triangle>& triangles,
-                                std::span<const Vec3f> positions) {
-  std::vector<std::array<Index, 2>> open = open_edges(triangles, positions.size());
-  return orient_components(triangles, positions, open);
+namespace {
+
+// A well-mixed 64-bit key of an undirected edge (splitmix64's finaliser).
+std::uint64_t edge_key(Index u, Index v) {
+  std::uint64_t x = u < v ? std::uint64_t{u} << 32 | v : std::uint64_t{v} << 32 | u;
+  x += 0x9E3779B97F4A7C15ull;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+  return x ^ (x >> 31);
 }
 
-std::uint64_t orient_components(std::vector<Triangle>& triangles, std::span<const Vec3f> positions,
-                                std::vector<std::array<Index, 2>>& open) {
+// open: the open edges when the caller has them (reversed with their component); null: a
+// component is open when the XOR of its triangles' edge keys is not zero. With no
+// non-manifold edge every inner edge is counted twice and cancels, so what is left is the XOR
+// of the boundary edges' keys, zero for a closed component and (but with odds of 2^-64) not zero
+// otherwise; no edge map over the whole mesh is needed.
+std::uint64_t orient(std::vector<Triangle>& triangles, std::span<const Vec3f> positions,
+                     std::vector<std::array<Index, 2>>* open) {
   const auto nv = static_cast<std::uint32_t>(positions.size());
   std::vector<std::uint32_t> parent(nv);
   std::iota(parent.begin(), parent.end(), 0u);
@@ -56,6 +66,7 @@ std::uint64_t orient_components(std::vector<Triangle>& triangles, std::span<cons
     Vec3 normal{0, 0, 0};
     double volume = 0;
     bool open = false;
+    std::uint64_t edges = 0;  // XOR of the edge keys
     double count = 0;
   };
   std::vector<Sum> sums(components);
@@ -65,7 +76,15 @@ std::uint64_t orient_components(std::vector<Triangle>& triangles, std::span<cons
     for (Index v : t) s.centroid = s.centroid + pos(v);
     s.count += 3;
   }
-  for (const auto& e : open) sums[component_of(e[0])].open = true;
+  if (open) {
+    for (const auto& e : *open) sums[component_of(e[0])].open = true;
+  } else {
+    for (const Triangle& t : triangles) {
+      sums[component_of(t[0])].edges ^=
+          edge_key(t[0], t[1]) ^ edge_key(t[1], t[2]) ^ edge_key(t[2], t[0]);
+    }
+    for (Sum& s : sums) s.open = s.edges != 0;
+  }
   for (const Triangle& t : triangles) {
     Sum& s = sums[component_of(t[0])];
     const Vec3 o = s.centroid * (1.0 / s.count);
@@ -84,10 +103,24 @@ std::uint64_t orient_components(std::vector<Triangle>& triangles, std::span<cons
   for (Triangle& t : triangles) {
     if (flip[component_of(t[0])]) std::swap(t[1], t[2]);
   }
-  for (auto& e : open) {
-    if (flip[component_of(e[0])]) std::swap(e[0], e[1]);
+  if (open) {
+    for (auto& e : *open) {
+      if (flip[component_of(e[0])]) std::swap(e[0], e[1]);
+    }
   }
   return flipped;
+}
+
+}  // namespace
+
+std::uint64_t orient_components(std::vector<Triangle>& triangles,
+                                std::span<const Vec3f> positions) {
+  return orient(triangles, positions, nullptr);
+}
+
+std::uint64_t orient_components(std::vector<Triangle>& triangles, std::span<const Vec3f> positions,
+                                std::vector<std::array<Index, 2>>& open) {
+  return orient(triangles, positions, &open);
 }
 
 }  // namespace g2s
