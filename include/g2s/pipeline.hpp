@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -54,8 +55,8 @@ struct PipelineOptions {
   double band_spacings = 6.0;
   // Points, in Gabriel order, a seam edge tries after its Gabriel point fails to join.
   int stitch_retries = 4;
-  // Called now and then with (tiles done, tiles in total), from one thread at a time, while
-  // growing and stitching (each tile counts twice); may be empty. mesh.progress is not used.
+  // Called with (tiles stitched, tiles in total), from one thread at a time, after each tile;
+  // may be empty. mesh.progress is not used.
   std::function<void(std::uint64_t, std::uint64_t)> progress;
 };
 
@@ -69,6 +70,22 @@ struct PipelineMesh {
   std::uint64_t tiles = 0;
   std::uint64_t triangles_stitched = 0;
   double seconds_stitch = 0.0;
+};
+
+// The seam stitcher, fed tile by tile in index order (as tiles finish growing), then finished:
+// the global non-manifold pass and the orientation of the components.
+class Stitcher {
+ public:
+  Stitcher(const TileSource& source, const PipelineOptions& options);
+  ~Stitcher();
+  Stitcher(const Stitcher&) = delete;
+  Stitcher& operator=(const Stitcher&) = delete;
+  void add(std::size_t tile, TileGrowth growth);  // tile = 0, 1, 2, ...
+  PipelineMesh finish();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 // Stitches the seams between grown tiles, removes non-manifold vertices and orients the

@@ -36,6 +36,18 @@ inline bool box_contains(const TileBox& box, const double* p) {
   return true;
 }
 
+// The bounding box of all tiles: the cloud's.
+inline TileBox tiles_bounds(std::span<const TileInfo> tiles) {
+  TileBox b = tiles.empty() ? TileBox{} : tiles[0].box;
+  for (const TileInfo& t : tiles) {
+    for (int a = 0; a < 3; ++a) {
+      b.lo[a] = std::min(b.lo[a], t.box.lo[a]);
+      b.hi[a] = std::max(b.hi[a], t.box.hi[a]);
+    }
+  }
+  return b;
+}
+
 // The tiles other than `tile` whose boxes lie within `reach` of its box, in index order.
 inline std::vector<std::size_t> tiles_near(std::span<const TileInfo> tiles, std::size_t tile,
                                            double reach) {

@@ -42,8 +42,8 @@ class SeamStitcher {
   SeamStitcher(const TileSource& source, const PipelineOptions& options, std::size_t ids)
       : source_(source), options_(options), in_band_(ids, 0), loaded_(ids, 0) {}
 
-  // Closes the seams between `tile` and its neighbours with smaller indices. xyz: every point's
-  // position by global id.
+  // Closes the seams between `tile` and its neighbours with smaller indices. xyz: positions by
+  // global id, filled for the tiles up to `tile`.
   std::uint64_t stitch(std::size_t tile, const std::vector<double>& xyz, KeptMesh& kept) {
     const std::span<const TileInfo> tiles = source_.tiles();
     const TileBox& box = tiles[tile].box;
@@ -61,29 +61,35 @@ class SeamStitcher {
 
     // The band (growable) and its context, from the tile and its neighbours' borders.
     ids_.clear();
-    auto take = [&](Index id, bool growable) {
+    local_.clear();
+    // Positions in a float frame at the tile's centre (offsets computed in double).
+    auto take = [&](Index id, bool growable, const double* p) {
       if (loaded_[id]) return;
       loaded_[id] = 1;
       in_band_[id] = growable;
       ids_.push_back(id);
+      for (int a = 0; a < 3; ++a) {
+        local_.push_back(static_cast<float>(p[a] - 0.5 * (box.lo[a] + box.hi[a])));
+      }
     };
     {
       const TilePoints own = source_.load_border(tile, reach);
       for (std::size_t k = 0; k < own.size(); ++k) {
         double d = reach + 1;
         for (std::size_t j : earlier) d = std::min(d, box_distance(tiles[j].box, &own.xyz[3 * k]));
-        if (d <= reach) take(own.ids[k], d <= band);
+        if (d <= reach) take(own.ids[k], d <= band, &own.xyz[3 * k]);
       }
     }
     for (std::size_t j : near) {
       const TilePoints border = source_.load_border(j, reach);
       for (std::size_t k = 0; k < border.size(); ++k) {
         const double d = box_distance(box, &border.xyz[3 * k]);
-        if (d <= reach) take(border.ids[k], j < tile && d <= band);
+        if (d <= reach) take(border.ids[k], j < tile && d <= band, &border.xyz[3 * k]);
       }
     }
     // Every kept triangle touching the band, presented facing as its group currently does, so
-    // the grower starts from what earlier seams already decided.
+    // the grower starts from what earlier seams already decided. Its corners are in tiles up to
+    // this one, whose positions `xyz` already holds.
     preload_.clear();
     preload_group_.clear();
     for (std::uint32_t t = 0; t < kept.triangles.size(); ++t) {
@@ -92,17 +98,10 @@ class SeamStitcher {
       const auto [root, parity] = kept.groups.find(kept.group[t]);
       preload_.push_back(parity ? Triangle{tri[0], tri[2], tri[1]} : tri);
       preload_group_.push_back(root);
-      for (Index v : tri) take(v, in_band_[v]);
+      for (Index v : tri) take(v, in_band_[v], &xyz[3 * std::size_t{v}]);
     }
 
-    std::vector<float> local(3 * ids_.size());
-    for (std::size_t k = 0; k < ids_.size(); ++k) {
-      for (int a = 0; a < 3; ++a) {
-        local[3 * k + a] =
-            static_cast<float>(xyz[3 * std::size_t{ids_[k]} + a] - 0.5 * (box.lo[a] + box.hi[a]));
-      }
-    }
-    const HashGrid grid(local, ids_);
+    const HashGrid grid(local_, ids_);
     // Global id -> grid index for the preloaded corners (the grid keeps the smallest id of exact
     // duplicates, as every tile's grid does, so all kept corners are in it).
     std::vector<std::pair<Index, std::uint32_t>> index(grid.size());
@@ -175,74 +174,85 @@ class SeamStitcher {
   std::vector<std::uint8_t> in_band_;  // by global id, for the points of the current seam
   std::vector<std::uint8_t> loaded_;
   std::vector<Index> ids_;
+  std::vector<float> local_;
   std::vector<Triangle> preload_;
   std::vector<std::uint32_t> preload_group_;
 };
 
 }  // namespace
 
-PipelineMesh stitch_tiles(const TileSource& source, std::vector<TileGrowth> growths,
-                          const PipelineOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  const std::span<const TileInfo> tiles = source.tiles();
-  if (growths.size() != tiles.size()) throw Error(Exit::failure, "stitch: one growth per tile");
-  PipelineMesh out;
-  out.tiles = tiles.size();
-  const std::uint64_t n = source.point_count();
-  if (n > kNoIndex) throw Error(Exit::bad_input, "cloud has more than 4,294,967,295 points");
-  out.xyz.assign(3 * n, 0.0);
-  for (std::size_t t = 0; t < tiles.size(); ++t) {
-    const TilePoints points = source.load(t);
-    for (std::size_t k = 0; k < points.size(); ++k) {
-      if (points.ids[k] >= n)
-        throw Error(Exit::bad_input, "tile store: a point id is out of range");
-      std::copy_n(&points.xyz[3 * k], 3, &out.xyz[3 * std::size_t{points.ids[k]}]);
-    }
-  }
-
+struct Stitcher::Impl {
+  Impl(const TileSource& s, const PipelineOptions& o)
+      : source(s), options(o), n(s.point_count()), stitcher(s, o, n) {}
+  const TileSource& source;
+  const PipelineOptions& options;
+  const std::uint64_t n;
+  SeamStitcher stitcher;
   KeptMesh kept;
-  for (TileGrowth& g : growths) {
-    const auto base = static_cast<std::uint32_t>(kept.groups.size());
-    for (std::uint32_t k = 0; k < g.groups; ++k) kept.groups.add();
-    kept.triangles.insert(kept.triangles.end(), g.triangles.begin(), g.triangles.end());
-    for (std::uint32_t group : g.group) kept.group.push_back(base + group);
-    kept.second_fans.insert(kept.second_fans.end(), g.second_fans.begin(), g.second_fans.end());
-    out.report.points += g.report.points;
-    out.report.seeds += g.report.seeds;
-    out.report.seconds_grid += g.report.seconds_grid;
-    out.report.seconds_grow += g.report.seconds_grow;
-    out.report.spacing = std::max(out.report.spacing, g.report.spacing);
-    g = TileGrowth{};
-  }
-  SeamStitcher stitcher(source, options, n);
-  for (std::size_t t = 0; t < tiles.size(); ++t) {
-    out.triangles_stitched += stitcher.stitch(t, out.xyz, kept);
-    if (options.progress) options.progress(tiles.size() + t + 1, 2 * tiles.size());
-  }
-  out.seconds_stitch = seconds_since(start);
+  PipelineMesh out;
+  std::size_t next = 0;  // the tile add() expects
+};
 
+Stitcher::Stitcher(const TileSource& source, const PipelineOptions& options) {
+  if (source.point_count() > kNoIndex) {
+    throw Error(Exit::bad_input, "cloud has more than 4,294,967,295 points");
+  }
+  impl_ = std::make_unique<Impl>(source, options);
+  impl_->out.tiles = source.tiles().size();
+  impl_->out.xyz.assign(3 * impl_->n, 0.0);
+}
+
+Stitcher::~Stitcher() = default;
+
+void Stitcher::add(std::size_t tile, TileGrowth growth) {
+  Impl& m = *impl_;
+  if (tile != m.next) throw Error(Exit::failure, "stitch: tiles must come in index order");
+  ++m.next;
+  const auto start = std::chrono::steady_clock::now();
+  const TilePoints points = m.source.load(tile);
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    if (points.ids[k] >= m.n)
+      throw Error(Exit::bad_input, "tile store: a point id is out of range");
+    std::copy_n(&points.xyz[3 * k], 3, &m.out.xyz[3 * std::size_t{points.ids[k]}]);
+  }
+  const auto base = static_cast<std::uint32_t>(m.kept.groups.size());
+  for (std::uint32_t k = 0; k < growth.groups; ++k) m.kept.groups.add();
+  m.kept.triangles.insert(m.kept.triangles.end(), growth.triangles.begin(), growth.triangles.end());
+  for (std::uint32_t group : growth.group) m.kept.group.push_back(base + group);
+  m.kept.second_fans.insert(m.kept.second_fans.end(), growth.second_fans.begin(),
+                            growth.second_fans.end());
+  MeshReport& r = m.out.report;
+  r.points += growth.report.points;
+  r.seeds += growth.report.seeds;
+  r.seconds_grid += growth.report.seconds_grid;
+  r.seconds_grow += growth.report.seconds_grow;
+  r.spacing = std::max(r.spacing, growth.report.spacing);
+  growth = TileGrowth{};
+  m.out.triangles_stitched += m.stitcher.stitch(tile, m.out.xyz, m.kept);
+  m.out.seconds_stitch += seconds_since(start);
+}
+
+PipelineMesh Stitcher::finish() {
+  Impl& m = *impl_;
+  if (m.next != m.source.tiles().size()) throw Error(Exit::failure, "stitch: a tile is missing");
+  const std::span<const TileInfo> tiles = m.source.tiles();
+  PipelineMesh& out = m.out;
+  KeptMesh& kept = m.kept;
   const auto cleanup_start = std::chrono::steady_clock::now();
   for (std::size_t t = 0; t < kept.triangles.size(); ++t) {
-    if (kept.groups.find(kept.group[t]).second)
+    if (kept.groups.find(kept.group[t]).second) {
       std::swap(kept.triangles[t][1], kept.triangles[t][2]);
+    }
   }
   out.report.triangles_grown = kept.triangles.size();
-  const NonManifoldReport nm = remove_non_manifold_vertices_at(kept.triangles, n, kept.second_fans);
+  const NonManifoldReport nm =
+      remove_non_manifold_vertices_at(kept.triangles, m.n, kept.second_fans);
   out.report.triangles_removed = nm.triangles_removed;
   out.report.non_manifold_vertices_fixed = nm.vertices_fixed;
-  if (options.mesh.orient) {
-    const TileBox bounds = [&] {
-      TileBox b = tiles.empty() ? TileBox{} : tiles[0].box;
-      for (const TileInfo& t : tiles) {
-        for (int a = 0; a < 3; ++a) {
-          b.lo[a] = std::min(b.lo[a], t.box.lo[a]);
-          b.hi[a] = std::max(b.hi[a], t.box.hi[a]);
-        }
-      }
-      return b;
-    }();
-    std::vector<Vec3f> positions(n);
-    for (std::size_t i = 0; i < n; ++i) {
+  if (m.options.mesh.orient) {
+    const TileBox bounds = tiles_bounds(tiles);
+    std::vector<Vec3f> positions(m.n);
+    for (std::size_t i = 0; i < m.n; ++i) {
       positions[i] = {static_cast<float>(out.xyz[3 * i] - 0.5 * (bounds.lo[0] + bounds.hi[0])),
                       static_cast<float>(out.xyz[3 * i + 1] - 0.5 * (bounds.lo[1] + bounds.hi[1])),
                       static_cast<float>(out.xyz[3 * i + 2] - 0.5 * (bounds.lo[2] + bounds.hi[2]))};
@@ -251,7 +261,20 @@ PipelineMesh stitch_tiles(const TileSource& source, std::vector<TileGrowth> grow
   }
   out.triangles = std::move(kept.triangles);
   out.report.seconds_cleanup = seconds_since(cleanup_start);
-  return out;
+  return std::move(out);
+}
+
+PipelineMesh stitch_tiles(const TileSource& source, std::vector<TileGrowth> growths,
+                          const PipelineOptions& options) {
+  if (growths.size() != source.tiles().size()) {
+    throw Error(Exit::failure, "stitch: one growth per tile");
+  }
+  Stitcher stitcher(source, options);
+  for (std::size_t t = 0; t < growths.size(); ++t) {
+    stitcher.add(t, std::move(growths[t]));
+    if (options.progress) options.progress(t + 1, growths.size());
+  }
+  return stitcher.finish();
 }
 
 }  // namespace g2s
