@@ -39,9 +39,16 @@ AtomicFile::AtomicFile(const std::filesystem::path& target) : target_(target) {
     fail_write(target_, "cannot write", EISDIR);
   temporary_ = target_.parent_path() /
                fmt::format(".{}.tmp-{}-{}", name, static_cast<long>(::getpid()), g_counter++);
-  fd_ = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-  if (fd_ < 0) fail_write(target_, "cannot create", errno);
+  // Registered before it exists, so a signal arriving just after it appears still removes it.
   registry_slot_ = register_temporary(temporary_.c_str());
+  fd_ = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd_ < 0) {
+    const int err = errno;
+    unregister_temporary(registry_slot_);
+    registry_slot_ = -1;
+    temporary_.clear();
+    fail_write(target_, "cannot create", err);
+  }
   buffer_.reserve(kBufferSize);
 }
 
