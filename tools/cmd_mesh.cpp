@@ -12,6 +12,7 @@
 #include "g2s/io.hpp"
 #include "g2s/mesher.hpp"
 #include "g2s/stats.hpp"
+#include "g2s/surface_check.hpp"
 
 namespace g2s::cli {
 namespace {
@@ -53,6 +54,20 @@ class Progress {
   bool enabled_;
 };
 
+// What the reader left out, on stderr: the input was usable, but not all of it was used.
+void print_input_notes(const std::string& input, const ReadReport& report) {
+  if (report.non_finite > 0) {
+    fmt::print(stderr, "g2s: note: {}: {} points with NaN or Inf coordinates dropped\n", input,
+               report.non_finite);
+  }
+  if (report.ignored_bytes > 0) {
+    fmt::print(stderr,
+               "g2s: note: {}: {} bytes after the {} declared vertices ignored (the header "
+               "declares fewer points than the file holds, or trailing data)\n",
+               input, report.ignored_bytes, report.declared);
+  }
+}
+
 void run_mesh(MeshArgs& args) {
   std::unique_ptr<tbb::global_control> threads;
   if (args.threads > 0) {
@@ -64,20 +79,28 @@ void run_mesh(MeshArgs& args) {
   progress.stage("reading", 0);
   ReadReport read_report;
   PointCloud cloud = read_points(args.input, &read_report);
-  if (cloud.size() == 0) {
-    throw Error(Exit::bad_input,
-                fmt::format("{}: no usable points ({} read, {} non-finite)", args.input,
-                            read_report.points + read_report.non_finite, read_report.non_finite));
+  if (const std::string why = why_no_surface(cloud); !why.empty()) {
+    const std::string dropped =
+        read_report.non_finite > 0 ? fmt::format(" ({} points with NaN or Inf coordinates dropped)",
+                                                 read_report.non_finite)
+                                   : "";
+    throw Error(Exit::no_surface, fmt::format("{}: no surface can be formed: {}{}; nothing written",
+                                              args.input, why, dropped));
   }
+  if (!args.quiet) print_input_notes(args.input, read_report);
   args.options.progress = [&](std::uint64_t used, std::uint64_t total) {
     progress.stage("meshing", static_cast<double>(used) / static_cast<double>(total));
   };
   TileMesh mesh = mesh_cloud(cloud, args.options);
   if (mesh.triangles.empty()) {
-    throw Error(Exit::bad_input,
-                fmt::format("{}: no triangle could be formed from {} points (too few, collinear "
-                            "or too sparse); nothing written",
-                            args.input, cloud.size()));
+    throw Error(Exit::no_surface,
+                fmt::format("{}: no surface can be formed: no triangle found among {} points (too "
+                            "sparse for --max-radius {}?); nothing written",
+                            args.input, cloud.size(), args.options.max_radius));
+  }
+  if (!args.quiet && mesh.report.duplicates_merged > 0) {
+    fmt::print(stderr, "g2s: note: {}: {} exact duplicate points merged\n", args.input,
+               mesh.report.duplicates_merged);
   }
   progress.stage("writing", 1);
   write_mesh(args.output, cloud.xyz, mesh.triangles, mesh_format_for(args.output, args.ascii));
@@ -94,14 +117,15 @@ void run_mesh(MeshArgs& args) {
   }
   if (args.json) {
     fmt::print(
-        "{{\"input\":\"{}\",\"output\":\"{}\",\"points\":{},\"non_finite\":{},"
+        "{{\"input\":\"{}\",\"output\":\"{}\",\"points\":{},\"non_finite\":{},\"ignored_bytes\":{},"
         "\"duplicates_merged\":{},\"spacing\":{},\"seeds\":{},\"triangles\":{},"
         "\"triangles_removed\":{},\"seconds\":{:.3f},\"seconds_grid\":{:.3f},"
         "\"seconds_grow\":{:.3f},\"seconds_cleanup\":{:.3f},\"ktriangles_per_second\":{:.1f},"
         "\"peak_rss_mb\":{:.1f}",
-        args.input, args.output, r.points, read_report.non_finite, r.duplicates_merged, r.spacing,
-        r.seeds, r.triangles_grown - r.triangles_removed, r.triangles_removed, seconds,
-        r.seconds_grid, r.seconds_grow, r.seconds_cleanup, ktps, peak_rss_mb());
+        args.input, args.output, r.points, read_report.non_finite, read_report.ignored_bytes,
+        r.duplicates_merged, r.spacing, r.seeds, r.triangles_grown - r.triangles_removed,
+        r.triangles_removed, seconds, r.seconds_grid, r.seconds_grow, r.seconds_cleanup, ktps,
+        peak_rss_mb());
     if (!args.no_stats) fmt::print(",\"stats\":{}", stats_to_json(stats));
     fmt::print("}}\n");
     return;
@@ -125,7 +149,12 @@ void run_mesh(MeshArgs& args) {
 void add_mesh_command(CLI::App& app) {
   auto args = std::make_shared<MeshArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "mesh", "Reconstruct a triangle mesh from a point cloud (PLY, XYZ/PTS) with G2S");
+      "mesh",
+      "Reconstruct a triangle mesh from a point cloud (PLY, XYZ/PTS) with G2S.\n"
+      "NaN/Inf points are dropped and exact duplicates merged (a note says how many).\n"
+      "Exit 3 for a missing or malformed file; exit 5, with nothing written, when the points\n"
+      "cannot form a surface: none usable, all the same point, only two distinct points, all\n"
+      "on one straight line, or too sparse for any triangle. Flat (coplanar) clouds mesh.");
   cmd->add_option("input", args->input, "Point cloud: PLY (ascii/binary) or text XYZ/PTS")
       ->required();
   cmd->add_option("-o,--output", args->output,

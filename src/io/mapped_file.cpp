@@ -11,6 +11,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <utility>
 
 #include "g2s/error.hpp"
 
@@ -64,6 +65,12 @@ MappedFile::MappedFile(const std::filesystem::path& path) : name_(path.string())
   copy_.resize(used);
   data_ = copy_.data();
   size_ = used;
+}
+
+MappedFile::MappedFile(std::string name, std::string_view bytes)
+    : name_(std::move(name)), copy_(bytes.begin(), bytes.end()) {
+  data_ = copy_.data();
+  size_ = copy_.size();
 }
 
 MappedFile::~MappedFile() {

@@ -1,5 +1,7 @@
 // Read-only view of a whole input file for the readers: mmap for regular files (no copy, the
-// page cache does the work), a read() loop for pipes and /proc-like files. Opening problems
+// page cache does the work), a read() loop for pipes and /proc-like files, or a copy of bytes
+// already in memory (the fuzz targets: an exactly sized heap buffer, so a read past the end is
+// caught by AddressSanitizer, which an mmap's page padding would hide). Opening problems
 // (missing, directory, permission) throw Error(bad_input) naming the file.
 #pragma once
 
@@ -14,6 +16,7 @@ namespace g2s::io {
 class MappedFile {
  public:
   explicit MappedFile(const std::filesystem::path& path);
+  MappedFile(std::string name, std::string_view bytes);  // a copy of bytes, called `name`
   ~MappedFile();
   MappedFile(const MappedFile&) = delete;
   MappedFile& operator=(const MappedFile&) = delete;

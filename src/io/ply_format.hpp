@@ -82,6 +82,7 @@ struct PlyBodyRequest {
 struct PlyBodyResult {
   std::vector<double> xyz;
   std::uint64_t non_finite = 0;
+  std::size_t end = 0;  // first byte after the last element read
 };
 
 // Walks the body of every element in header order (other elements and properties skipped,

@@ -1,6 +1,7 @@
 // read_points: opens the file once, sniffs the content (the "ply" magic line, else text; binary
 // bytes in a non-PLY file are an error) and hands it to the PLY or the XYZ reader. The CLI
 // decides what an empty cloud means; at this layer zero points is a valid answer.
+#include <algorithm>
 #include <string_view>
 
 #include "g2s/io.hpp"
@@ -10,26 +11,42 @@
 #include "io/text_util.hpp"
 
 namespace g2s {
+namespace io {
+namespace {
 
-PointCloud read_points(const std::filesystem::path& path, ReadReport* report) {
-  ReadReport local;
-  ReadReport& r = report != nullptr ? *report : local;
-  r = ReadReport{};
-  const io::MappedFile file(path);
-  if (file.size() == 0) {
-    io::fail_input(file.name(), "file is empty (expected a PLY or XYZ/PTS point cloud)");
+// Bytes from `end` on that hold something: all of them in a binary body, none when an ASCII
+// body is followed only by blanks and line ends.
+std::uint64_t bytes_holding_data(const MappedFile& file, std::size_t end, bool ascii) {
+  const std::string_view rest = file.view().substr(std::min(end, file.size()));
+  if (!ascii) return rest.size();
+  for (char c : rest) {
+    if (!is_blank(c) && c != '\n') return rest.size();
   }
-  if (io::has_ply_magic(file)) {
-    const io::PlyHeader header = io::parse_ply_header(file);
-    r.format = io::ply_format_name(header.encoding);
-    r.declared = header.elements.empty() || header.find("vertex") < 0
-                     ? 0
-                     : header.elements[static_cast<std::size_t>(header.find("vertex"))].count;
-    io::PlyBodyResult body = io::read_ply_body(file, header, io::PlyBodyRequest{});
+  return 0;
+}
+
+}  // namespace
+
+PointCloud read_points_from(const MappedFile& file, ReadReport& report) {
+  report = ReadReport{};
+  if (file.size() == 0) {
+    fail_input(file.name(), "file is empty (expected a PLY or XYZ/PTS point cloud)");
+  }
+  if (has_ply_magic(file)) {
+    const PlyHeader header = parse_ply_header(file);
+    const int vertex = header.find("vertex");
+    report.format = ply_format_name(header.encoding);
+    report.declared = vertex < 0 ? 0 : header.elements[static_cast<std::size_t>(vertex)].count;
+    PlyBodyResult body = read_ply_body(file, header, PlyBodyRequest{});
+    // Only when the vertices come last is what follows them surely not a declared element.
+    if (vertex == static_cast<int>(header.elements.size()) - 1) {
+      report.ignored_bytes =
+          bytes_holding_data(file, body.end, header.encoding == PlyEncoding::ascii);
+    }
     PointCloud cloud;
     cloud.xyz = std::move(body.xyz);
-    r.points = cloud.size();
-    r.non_finite = body.non_finite;
+    report.points = cloud.size();
+    report.non_finite = body.non_finite;
     return cloud;
   }
   // Text is expected: printable bytes, blanks and line ends (UTF-8 in comments is fine).
@@ -37,14 +54,22 @@ PointCloud read_points(const std::filesystem::path& path, ReadReport* report) {
   for (std::size_t i = 0; i < head.size(); ++i) {
     const auto c = static_cast<unsigned char>(head[i]);
     if (c < 0x20 && c != '\t' && c != '\n' && c != '\r' && c != '\f' && c != '\v') {
-      io::fail_input(file.name(),
-                     "byte {}: binary data (byte value 0x{:02x}) in a file that is not PLY (it "
-                     "does not start with a 'ply' line); expected a PLY or an XYZ/PTS text point "
-                     "cloud",
-                     i, c);
+      fail_input(file.name(),
+                 "byte {}: binary data (byte value 0x{:02x}) in a file that is not PLY (it "
+                 "does not start with a 'ply' line); expected a PLY or an XYZ/PTS text point "
+                 "cloud",
+                 i, c);
     }
   }
-  return io::read_xyz_points(file, r);
+  return read_xyz_points(file, report);
+}
+
+}  // namespace io
+
+PointCloud read_points(const std::filesystem::path& path, ReadReport* report) {
+  ReadReport local;
+  const io::MappedFile file(path);
+  return io::read_points_from(file, report != nullptr ? *report : local);
 }
 
 }  // namespace g2s

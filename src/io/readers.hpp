@@ -8,6 +8,10 @@
 
 namespace g2s::io {
 
+// read_points and read_mesh on an opened file (point_reader.cpp, mesh_reader.cpp).
+PointCloud read_points_from(const MappedFile& file, ReadReport& report);
+IndexedMesh read_mesh_from(const MappedFile& file);
+
 // Text XYZ/PTS/CSV points (xyz_reader.cpp). Fills report->format/points/non_finite.
 PointCloud read_xyz_points(const MappedFile& file, ReadReport& report);
 

@@ -1,0 +1,19 @@
+// Whether a cloud can make a surface at all, asked before meshing so that the CLI can say why
+// nothing was written instead of producing an empty or sliver-only mesh (src/check/).
+#pragma once
+
+#include <string>
+
+#include "g2s/types.hpp"
+
+namespace g2s {
+
+// Why the points of `cloud` cannot form any surface, or "" when they can. A surface needs three
+// distinct points that are not on one straight line; the answer names the case: no points, all
+// points the same, only two distinct points, or all points on one line. "On one line" allows
+// for float rounding (the mesher works in float): every point within 1e-6 of the cloud's length
+// of the line through two points about a diameter apart (found by two farthest-point sweeps).
+// Linear time; only the collinear case allocates (to count distinct points).
+std::string why_no_surface(const PointCloud& cloud);
+
+}  // namespace g2s
