@@ -352,6 +352,19 @@ TEST_F(BadInput, GeoreferencedCoordinatesMeshLocallyAndAreWrittenBackExactly) {
   EXPECT_GE(json_number(stats.out, "coverage"), 0.99) << stats.out;
 }
 
+// STL cannot hold such coordinates: writing it works but says what is lost.
+TEST_F(BadInput, GeoreferencedCoordinatesToStlWarnAboutFloatRounding) {
+  std::vector<Point> points = wavy_patch();
+  for (Point& p : points) p = {1.0e7 + 0.08 * p[0], 5.0e6 + 0.08 * p[1], 250.0 + 0.08 * p[2]};
+  const fs::path stl = dir_ / "geo.stl";
+  const CliRun r = mesh(write("geo.xyz", xyz_text(points)), stl);
+  ASSERT_EQ(r.exit_code, kOk) << r.err;
+  EXPECT_NE(r.err.find("warning: " + stl.string() + ": STL stores 32-bit floats"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("write .ply to keep them exactly"), std::string::npos) << r.err;
+}
+
 // Exact duplicates are merged: the mesh is the one of the distinct points, byte for byte.
 TEST_F(BadInput, DuplicatePointsAreMerged) {
   const std::vector<Point> points = wavy_patch();

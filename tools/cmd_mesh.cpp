@@ -4,7 +4,9 @@
 #include <tbb/global_control.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 
 #include "commands.hpp"
@@ -68,6 +70,23 @@ void print_input_notes(const std::string& input, const ReadReport& report) {
   }
 }
 
+// STL holds 32-bit floats, whose step near 1e7 (georeferenced scans) is a metre: warn when that
+// rounding moves vertices by more than a hundredth of the sampling spacing.
+void warn_if_stl_rounds(const std::string& output, const PointCloud& cloud, double spacing) {
+  double largest = 0.0, worst = 0.0;
+  for (const double c : cloud.xyz) {
+    largest = std::max(largest, std::abs(c));
+    worst = std::max(worst, std::abs(c - static_cast<double>(static_cast<float>(c))));
+  }
+  if (worst > 0.01 * spacing) {
+    fmt::print(stderr,
+               "g2s: warning: {}: STL stores 32-bit floats, which round coordinates as large as "
+               "{:.6g} by up to {:.3g} (the point spacing is {:.3g}); write .ply to keep them "
+               "exactly\n",
+               output, largest, worst, spacing);
+  }
+}
+
 void run_mesh(MeshArgs& args) {
   std::unique_ptr<tbb::global_control> threads;
   if (args.threads > 0) {
@@ -102,8 +121,12 @@ void run_mesh(MeshArgs& args) {
     fmt::print(stderr, "g2s: note: {}: {} exact duplicate points merged\n", args.input,
                mesh.report.duplicates_merged);
   }
+  const MeshFormat format = mesh_format_for(args.output, args.ascii);
+  if (!args.quiet && format != MeshFormat::ply_binary) {
+    warn_if_stl_rounds(args.output, cloud, mesh.report.spacing);
+  }
   progress.stage("writing", 1);
-  write_mesh(args.output, cloud.xyz, mesh.triangles, mesh_format_for(args.output, args.ascii));
+  write_mesh(args.output, cloud.xyz, mesh.triangles, format);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   progress.clear();
