@@ -46,6 +46,13 @@ TEST(SurfaceCheck, CollinearWithinFloatRounding) {
       says(why_no_surface(line), "all 1000 points (1000 distinct) lie on one straight line"));
 }
 
+// Beyond float range the mesher would see infinities; here squared distances would overflow.
+TEST(SurfaceCheck, CoordinatesBeyondFloatRange) {
+  EXPECT_TRUE(says(why_no_surface(cloud_of({0, 0, 0, 1, 0, 0, 0, 1, 0, 1e300, 0, 0})),
+                   "the points span 1e+300 along x"));
+  EXPECT_TRUE(says(why_no_surface(cloud_of({0, 0, 0, 1, 0, 0, 0, -1e200, 1})), "along y"));
+}
+
 TEST(SurfaceCheck, ThreePointsOffALineCanMakeASurface) {
   EXPECT_EQ(why_no_surface(cloud_of({0, 0, 0, 1, 0, 0, 0, 1, 0})), "");
 }

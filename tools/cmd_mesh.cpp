@@ -118,8 +118,10 @@ void run_mesh(MeshArgs& args) {
                             args.input, cloud.size(), args.options.max_radius));
   }
   if (!args.quiet && mesh.report.duplicates_merged > 0) {
-    fmt::print(stderr, "g2s: note: {}: {} exact duplicate points merged\n", args.input,
-               mesh.report.duplicates_merged);
+    fmt::print(stderr,
+               "g2s: note: {}: {} duplicate points merged (equal in the mesher's float "
+               "coordinates)\n",
+               args.input, mesh.report.duplicates_merged);
   }
   const MeshFormat format = mesh_format_for(args.output, args.ascii);
   if (!args.quiet && format != MeshFormat::ply_binary) {

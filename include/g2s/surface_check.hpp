@@ -10,7 +10,8 @@ namespace g2s {
 
 // Why the points of `cloud` cannot form any surface, or "" when they can. A surface needs three
 // distinct points that are not on one straight line; the answer names the case: no points, all
-// points the same, only two distinct points, or all points on one line. "On one line" allows
+// points the same, only two distinct points, all points on one line, or (as the mesher works in
+// float) a cloud wider than 1e38 along an axis. "On one line" allows
 // for float rounding (the mesher works in float): every point within 1e-6 of the cloud's length
 // of the line through two points about a diameter apart (found by two farthest-point sweeps).
 // Linear time; only the collinear case allocates (to count distinct points).

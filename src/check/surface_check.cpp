@@ -15,6 +15,9 @@ namespace {
 
 using Point = std::array<double, 3>;
 
+// Widest extent along an axis that float (up to 3.4e38) holds with room to spare.
+constexpr double kWidestSpan = 1e38;
+
 Point point_at(const PointCloud& cloud, std::size_t i) {
   return {cloud.xyz[3 * i], cloud.xyz[3 * i + 1], cloud.xyz[3 * i + 2]};
 }
@@ -47,6 +50,21 @@ std::size_t count_distinct(const PointCloud& cloud) {
 std::string why_no_surface(const PointCloud& cloud) {
   const std::size_t n = cloud.size();
   if (n == 0) return "the cloud has no points";
+  // The mesher works in float around the bounding-box centre: a wider cloud (a wild coordinate
+  // such as 1e300) would turn into infinities there, and its squared distances overflow here.
+  for (int axis = 0; axis < 3; ++axis) {
+    double lo = cloud.xyz[axis], hi = lo;
+    for (std::size_t i = 0; i < n; ++i) {
+      lo = std::min(lo, cloud.xyz[3 * i + axis]);
+      hi = std::max(hi, cloud.xyz[3 * i + axis]);
+    }
+    if (!(hi - lo <= kWidestSpan)) {
+      return fmt::format(
+          "the points span {:.3g} along {}, beyond the range of the float coordinates the mesher "
+          "works in (a wild coordinate?)",
+          hi - lo, "xyz"[axis]);
+    }
+  }
   // Two sweeps of "farthest point" give two points nearly a diameter apart: the line through
   // them is the only candidate for a line holding every point.
   const Point a = point_at(cloud, farthest_from(cloud, point_at(cloud, 0)));
@@ -71,7 +89,10 @@ std::string why_no_surface(const PointCloud& cloud) {
   if (distinct == 2) {
     return fmt::format("the cloud has only 2 distinct points ({} in all)", n);
   }
-  return fmt::format("all {} points ({} distinct) lie on one straight line", n, distinct);
+  return fmt::format(
+      "all {} points ({} distinct) lie on one straight line (to within {:.3g}, a millionth of "
+      "their extent)",
+      n, distinct, tolerance);
 }
 
 }  // namespace g2s
