@@ -372,6 +372,19 @@ TEST_F(BadInput, GeoreferencedCoordinatesToStlWarnAboutFloatRounding) {
   EXPECT_NE(r.err.find("write .ply to keep them exactly"), std::string::npos) << r.err;
 }
 
+// A stray point at the origin of a georeferenced scan makes the mesher's float frame too coarse
+// for the scan's detail: the run says so.
+TEST_F(BadInput, GeoreferencedScanWithAStrayPointAtTheOriginWarns) {
+  std::string text = "0 0 0\n";
+  for (int i = 0; i < 80; ++i) {
+    for (int j = 0; j < 80; ++j)
+      text += fmt::format("{} {} 250\n", 1.0e7 + 0.25 * i, 5.0e6 + 0.25 * j);
+  }
+  const CliRun r = mesh(write("stray.xyz", text), out());
+  EXPECT_NE(r.err.find("warning: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("a stray point far from the rest?"), std::string::npos) << r.err;
+}
+
 // Exact duplicates are merged: the mesh is the one of the distinct points, byte for byte.
 TEST_F(BadInput, DuplicatePointsAreMerged) {
   const std::vector<Point> points = wavy_patch();

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "commands.hpp"
 #include "g2s/error.hpp"
@@ -87,6 +88,29 @@ void warn_if_stl_rounds(const std::string& output, const PointCloud& cloud, doub
   }
 }
 
+// The mesher works in float around the bounding-box centre, so a cloud far wider than its
+// sampling (a stray point at 0, 0, 0 in a georeferenced scan) loses its detail there: warn when
+// float's step at the cloud's half-width exceeds a tenth of the point spacing.
+void warn_if_local_frame_rounds(const std::string& input, const PointCloud& cloud, double spacing) {
+  double half_width = 0.0;
+  for (int axis = 0; axis < 3; ++axis) {
+    double lo = cloud.xyz[axis], hi = lo;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      lo = std::min(lo, cloud.xyz[3 * i + axis]);
+      hi = std::max(hi, cloud.xyz[3 * i + axis]);
+    }
+    half_width = std::max(half_width, 0.5 * (hi - lo));
+  }
+  const double step = half_width * std::numeric_limits<float>::epsilon();
+  if (step > 0.1 * spacing) {
+    fmt::print(stderr,
+               "g2s: warning: {}: the points spread {:.6g} from their centre, so the mesher's "
+               "float coordinates step by {:.3g}, too coarse for the point spacing {:.3g}: points "
+               "closer than that were merged (a stray point far from the rest?)\n",
+               input, half_width, step, spacing);
+  }
+}
+
 void run_mesh(MeshArgs& args) {
   std::unique_ptr<tbb::global_control> threads;
   if (args.threads > 0) {
@@ -117,6 +141,7 @@ void run_mesh(MeshArgs& args) {
                             "sparse for --max-radius {}?); nothing written",
                             args.input, cloud.size(), args.options.max_radius));
   }
+  if (!args.quiet) warn_if_local_frame_rounds(args.input, cloud, mesh.report.spacing);
   if (!args.quiet && mesh.report.duplicates_merged > 0) {
     fmt::print(stderr,
                "g2s: note: {}: {} duplicate points merged (equal in the mesher's float "
