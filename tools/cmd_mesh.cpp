@@ -106,7 +106,7 @@ void warn_if_local_frame_rounds(const std::string& input, const PointCloud& clou
     fmt::print(stderr,
                "g2s: warning: {}: the points spread {:.6g} from their centre, so the mesher's "
                "float coordinates step by {:.3g}, too coarse for the point spacing {:.3g}: points "
-               "closer than that were merged (a stray point far from the rest?)\n",
+               "closer than that may have merged (a stray point far from the rest?)\n",
                input, half_width, step, spacing);
   }
 }
