@@ -22,6 +22,8 @@
 
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
+#include "io/mapped_file.hpp"
+#include "io/readers.hpp"
 
 namespace {
 
@@ -311,9 +313,47 @@ TEST_F(IoPlyReader, ZeroPointsIsAnEmptyCloud) {
   EXPECT_EQ(report.declared, 0u);
 }
 
-TEST_F(IoPlyReader, TrailingBytesAfterTheBodyAreFine) {
+TEST_F(IoPlyReader, TrailingBytesAfterTheBodyAreFineAndCounted) {
   const fs::path path = write("trail.ply", simple_binary_ply(3, 3) + std::string(5, '\0'));
-  EXPECT_EQ(g2s::read_points(path).size(), 3u);
+  g2s::ReadReport report;
+  EXPECT_EQ(g2s::read_points(path, &report).size(), 3u);
+  EXPECT_EQ(report.ignored_bytes, 5u);
+}
+
+// An ASCII body may end in blank lines; a row more than declared is counted as ignored.
+TEST_F(IoPlyReader, AsciiRowsBeyondTheDeclaredCountAreCounted) {
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+      "property float z\nend_header\n0 0 0\n1 0 0\n";
+  g2s::ReadReport report;
+  EXPECT_EQ(g2s::read_points(write("blank.ply", header + "\n \r\n"), &report).size(), 2u);
+  EXPECT_EQ(report.ignored_bytes, 0u);
+  EXPECT_EQ(g2s::read_points(write("extra.ply", header + "0 1 0\n"), &report).size(), 2u);
+  EXPECT_EQ(report.ignored_bytes, 6u);
+}
+
+// Bytes after an element that follows the vertices belong to it, not to the vertices: nothing
+// is reported then, as that element is not read.
+TEST_F(IoPlyReader, ElementsAfterTheVerticesAreNotIgnoredBytes) {
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n3 0 0 0\n";
+  g2s::ReadReport report;
+  EXPECT_EQ(g2s::read_points(write("faces.ply", ply), &report).size(), 1u);
+  EXPECT_EQ(report.ignored_bytes, 0u);
+}
+
+// The fuzz targets read from memory: the same bytes give the same points and the same errors.
+TEST_F(IoPlyReader, InMemoryFileReadsLikeTheFileOnDisk) {
+  const std::string bytes = simple_binary_ply(3, 3);
+  g2s::ReadReport report;
+  const g2s::io::MappedFile in_memory("memory.ply", bytes);
+  EXPECT_EQ(g2s::io::read_points_from(in_memory, report).xyz,
+            g2s::read_points(write("disk.ply", bytes)).xyz);
+  const g2s::io::MappedFile cut("cut.ply", std::string_view(bytes).substr(0, bytes.size() - 1));
+  expect_error([&] { g2s::io::read_points_from(cut, report); }, Exit::bad_input,
+               {"cut.ply", "truncated"});
 }
 
 // ---- PLY errors ----

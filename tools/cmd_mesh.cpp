@@ -5,13 +5,16 @@
 #include <fmt/core.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <limits>
 
 #include "commands.hpp"
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
 #include "g2s/pipeline.hpp"
+#include "g2s/surface_check.hpp"
 #include "g2s/tile_store.hpp"
 #include "mesh_output.hpp"
 #include "progress.hpp"
@@ -39,9 +42,57 @@ bool reusable(const std::filesystem::path& store, const std::filesystem::path& i
   return !error && store_time >= input_time;
 }
 
+// What the reader left out, on stderr: the input was usable, but not all of it was used.
+void print_input_notes(const std::string& input, const ReadReport& report) {
+  if (report.non_finite > 0) {
+    fmt::print(stderr, "g2s: note: {}: {} points with NaN or Inf coordinates dropped\n", input,
+               report.non_finite);
+  }
+  if (report.ignored_bytes > 0) {
+    fmt::print(stderr,
+               "g2s: note: {}: {} bytes after the {} declared vertices ignored (the header "
+               "declares fewer points than the file holds, or trailing data)\n",
+               input, report.ignored_bytes, report.declared);
+  }
+}
+
+// Clouds up to this size are checked for being able to form a surface at all before meshing
+// (all points the same, two, on one line, beyond float's range); it needs them all in memory.
+constexpr std::uint64_t kCheckedWhole = std::uint64_t{1} << 22;
+
+[[noreturn]] void no_surface(const std::string& input, const std::string& why,
+                             std::uint64_t non_finite) {
+  const std::string dropped =
+      non_finite > 0 ? fmt::format(" ({} points with NaN or Inf coordinates dropped)", non_finite)
+                     : "";
+  throw Error(Exit::no_surface, fmt::format("{}: no surface can be formed: {}{}; nothing written",
+                                            input, why, dropped));
+}
+
+// Each tile is meshed in float around its centre, so a tile far wider than its sampling (a
+// stray point far from a georeferenced scan stretches its tile) loses detail: warn when float's
+// step at the tile's half-width exceeds a tenth of its point spacing.
+void warn_if_local_frame_rounds(const std::string& input, const TileStore& store) {
+  for (const TileInfo& t : store.tiles()) {
+    double half_width = 0.0;
+    for (int a = 0; a < 3; ++a)
+      half_width = std::max(half_width, 0.5 * (t.box.hi[a] - t.box.lo[a]));
+    const double step = half_width * std::numeric_limits<float>::epsilon();
+    if (t.points > 1 && step > 0.1 * t.spacing) {
+      fmt::print(stderr,
+                 "g2s: warning: {}: the points of a tile spread {:.6g} from its centre, so the "
+                 "mesher's float coordinates step by {:.3g}, too coarse for the point spacing "
+                 "{:.3g}: points closer than that may have merged (a stray point far from the "
+                 "rest?)\n",
+                 input, half_width, step, t.spacing);
+      return;
+    }
+  }
+}
+
 void run_mesh(MeshArgs& args) {
   Progress progress(!args.out.quiet && !args.out.json);
-  const RunFacts facts{args.input, 0, std::chrono::steady_clock::now()};
+  RunFacts run{args.input, 0, 0, std::chrono::steady_clock::now()};
   std::unique_ptr<TemporaryPath> temporary;
   std::filesystem::path store_path = args.keep_store;
   if (store_path.empty()) {
@@ -51,7 +102,7 @@ void run_mesh(MeshArgs& args) {
         fmt::format(".{}.store-{}", output.filename().string(), static_cast<long>(getpid())));
     store_path = temporary->path();
   }
-  RunFacts run = facts;
+  ReadReport read;
   if (temporary || !reusable(store_path, args.input)) {
     TileStoreOptions tiling;
     tiling.tile_points = args.tile_points;
@@ -59,21 +110,44 @@ void run_mesh(MeshArgs& args) {
     tiling.progress = [&](std::uint64_t done, std::uint64_t total) {
       progress.stage("tiling", total ? static_cast<double>(done) / static_cast<double>(total) : 1);
     };
-    build_tile_store(args.input, store_path, tiling);
+    read = build_tile_store(args.input, store_path, tiling).read;
   }
   const TileStore store(store_path);
-  run.non_finite = store.input_report().non_finite;
-  if (store.point_count() == 0) {
-    throw Error(Exit::bad_input,
-                fmt::format("{}: no usable points ({} non-finite)", args.input, run.non_finite));
+  if (read.format.empty()) read = store.input_report();
+  run.non_finite = read.non_finite;
+  run.ignored_bytes = read.ignored_bytes;
+  if (store.point_count() <= kCheckedWhole) {
+    PointCloud cloud;
+    for (std::size_t t = 0; t < store.tiles().size(); ++t) {
+      const TilePoints points = store.load(t);
+      cloud.xyz.insert(cloud.xyz.end(), points.xyz.begin(), points.xyz.end());
+    }
+    if (const std::string why = why_no_surface(cloud); !why.empty()) {
+      no_surface(args.input, why, read.non_finite);
+    }
   }
+  if (!args.out.quiet) print_input_notes(args.input, read);
   args.options.threads = args.threads;
   args.options.progress = [&](std::uint64_t done, std::uint64_t total) {
     progress.stage("meshing", static_cast<double>(done) / static_cast<double>(total));
   };
   PipelineMesh mesh = mesh_tiles(store, args.options);
-  progress.stage("writing", 1);
   progress.clear();
+  if (mesh.triangles.empty()) {
+    no_surface(args.input,
+               fmt::format("no triangle found among {} points (too sparse for --max-radius {}?)",
+                           store.point_count(), args.options.mesh.max_radius),
+               read.non_finite);
+  }
+  if (!args.out.quiet) {
+    warn_if_local_frame_rounds(args.input, store);
+    if (mesh.report.duplicates_merged > 0) {
+      fmt::print(stderr,
+                 "g2s: note: {}: {} duplicate points merged (equal in the mesher's float "
+                 "coordinates)\n",
+                 args.input, mesh.report.duplicates_merged);
+    }
+  }
   write_and_report(mesh, args.out, run);
 }
 

@@ -11,8 +11,9 @@ int main(int argc, char** argv) {
   CLI::App app{
       "g2s: fast manifold surface reconstruction of point clouds (G2S mesh growing).\n\n"
       "Exit codes: 0 success; 1 internal error; 2 bad command line; 3 bad input (missing,\n"
-      "unreadable, malformed, no usable points); 4 output could not be written (missing or\n"
-      "read-only folder, disk full); 130 interrupted."};
+      "unreadable or malformed file); 4 output could not be written (missing or read-only\n"
+      "folder, disk full); 5 no surface: the points cannot form one (none usable, all the same,\n"
+      "two distinct, all on one line, too sparse), nothing written; 130 interrupted."};
   g2s::install_interrupt_cleanup();
   app.require_subcommand(1);
   app.set_version_flag("--version", "g2s 0.1.0");

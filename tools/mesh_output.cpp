@@ -4,21 +4,48 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
 #include "g2s/stats.hpp"
 #include "progress.hpp"
 
 namespace g2s::cli {
+namespace {
+
+// STL holds 32-bit floats, whose step near 1e7 (georeferenced scans) is a metre: warn when that
+// rounding moves vertices by more than a hundredth of the sampling spacing.
+void warn_if_stl_rounds(const std::string& output, const std::vector<double>& xyz, double spacing) {
+  double largest = 0.0, worst = 0.0;
+  for (const double c : xyz) {
+    largest = std::max(largest, std::abs(c));
+    worst = std::max(worst, std::abs(c - static_cast<double>(static_cast<float>(c))));
+  }
+  if (worst > 0.01 * spacing) {
+    fmt::print(stderr,
+               "g2s: warning: {}: STL stores 32-bit floats, which round coordinates as large as "
+               "{:.6g} by up to {:.3g} (the point spacing is {:.3g}); write .ply to keep them "
+               "exactly\n",
+               output, largest, worst, spacing);
+  }
+}
+
+}  // namespace
 
 void write_and_report(PipelineMesh& mesh, const OutputArgs& args, const RunFacts& facts) {
   if (mesh.triangles.empty()) {
-    throw Error(Exit::bad_input,
-                fmt::format("{}: no triangle could be formed from {} points (too few, collinear "
-                            "or too sparse); nothing written",
+    throw Error(Exit::no_surface,
+                fmt::format("{}: no surface can be formed: no triangle found among {} points "
+                            "(too few, on one line, or too sparse); nothing written",
                             facts.input, mesh.report.points));
   }
-  write_mesh(args.output, mesh.xyz, mesh.triangles, mesh_format_for(args.output, args.ascii));
+  const MeshFormat format = mesh_format_for(args.output, args.ascii);
+  if (!args.quiet && format != MeshFormat::ply_binary) {
+    warn_if_stl_rounds(args.output, mesh.xyz, mesh.report.spacing);
+  }
+  write_mesh(args.output, mesh.xyz, mesh.triangles, format);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - facts.start).count();
   const MeshReport& r = mesh.report;
@@ -31,15 +58,15 @@ void write_and_report(PipelineMesh& mesh, const OutputArgs& args, const RunFacts
   }
   if (args.json) {
     fmt::print(
-        "{{\"input\":\"{}\",\"output\":\"{}\",\"points\":{},\"non_finite\":{},"
+        "{{\"input\":\"{}\",\"output\":\"{}\",\"points\":{},\"non_finite\":{},\"ignored_bytes\":{},"
         "\"duplicates_merged\":{},\"spacing\":{},\"seeds\":{},\"triangles\":{},"
         "\"triangles_removed\":{},\"tiles\":{},\"triangles_stitched\":{},\"seconds\":{:.3f},"
         "\"seconds_grid\":{:.3f},\"seconds_grow\":{:.3f},\"seconds_stitch\":{:.3f},"
         "\"seconds_cleanup\":{:.3f},\"ktriangles_per_second\":{:.1f},\"peak_rss_mb\":{:.1f}",
-        facts.input, args.output, r.points, facts.non_finite, r.duplicates_merged, r.spacing,
-        r.seeds, triangles, r.triangles_removed, mesh.tiles, mesh.triangles_stitched, seconds,
-        r.seconds_grid, r.seconds_grow, mesh.seconds_stitch, r.seconds_cleanup, ktps,
-        peak_rss_mb());
+        facts.input, args.output, r.points, facts.non_finite, facts.ignored_bytes,
+        r.duplicates_merged, r.spacing, r.seeds, triangles, r.triangles_removed, mesh.tiles,
+        mesh.triangles_stitched, seconds, r.seconds_grid, r.seconds_grow, mesh.seconds_stitch,
+        r.seconds_cleanup, ktps, peak_rss_mb());
     if (!args.no_stats) fmt::print(",\"stats\":{}", stats_to_json(stats));
     fmt::print("}}\n");
     return;

@@ -21,7 +21,8 @@ struct OutputArgs {
 // What the summary names besides the mesh itself.
 struct RunFacts {
   std::string input;             // the cloud or store meshed
-  std::uint64_t non_finite = 0;  // points the reader dropped
+  std::uint64_t non_finite = 0;     // points the reader dropped
+  std::uint64_t ignored_bytes = 0;  // after a PLY's declared vertices
   std::chrono::steady_clock::time_point start;
 };
 

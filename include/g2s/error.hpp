@@ -13,6 +13,7 @@ enum class Exit : int {
   usage = 2,          // bad command line
   bad_input = 3,      // input missing, unreadable, malformed, or holding no usable points
   write_failed = 4,   // output could not be written (missing folder, read-only, disk full)
+  no_surface = 5,     // input read, but its points cannot form a surface (none, same, on a line)
   interrupted = 130,  // SIGINT/SIGTERM: temporary files removed, no output left behind
 };
 

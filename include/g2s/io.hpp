@@ -19,6 +19,10 @@ struct ReadReport {
   std::uint64_t declared = 0;    // points the header declares (0 for XYZ)
   std::uint64_t points = 0;      // finite points returned
   std::uint64_t non_finite = 0;  // points dropped for a NaN or Inf coordinate
+  // Bytes after the declared vertices of a PLY whose last element is the vertex element (more
+  // data than the header declares, or trailing garbage), ignored; blanks after ASCII rows do not
+  // count.
+  std::uint64_t ignored_bytes = 0;
 };
 
 // Reads the points of a cloud. PLY (ascii, binary little and big endian; the vertex element's
@@ -26,7 +30,9 @@ struct ReadReport {
 // XYZ/PTS/TXT/CSV (space, tab or comma separated; extra columns ignored; '#' and '//' comment
 // lines; a PTS count line is skipped). The format is chosen by content (a "ply" magic line),
 // not by the file name; a non-PLY file holding binary bytes is an error. ASCII PLY rows are one
-// per line. Trailing bytes after a binary PLY's last element are ignored. NaN/Inf points are
+// per line. A PLY body is read as far as its header declares: bytes after the last element are
+// ignored (counted in report->ignored_bytes when the vertex element is the last element), a body
+// shorter than declared is an error. NaN/Inf points are
 // dropped and counted. Duplicates are kept (the mesher merges them). Zero points is not an error
 // here (an empty cloud is returned; the caller decides). Throws Error(bad_input) for a missing,
 // unreadable or malformed file: "<file>: line N: ..." (text, PLY header) or "<file>: byte N: ..."

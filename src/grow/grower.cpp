@@ -402,7 +402,8 @@ class Grower {
       near_.push_back({d2, j});
     });
     std::sort(near_.begin(), near_.end());
-    for (const auto& [d2, r] : near_) {
+    for (const auto& candidate : near_) {
+      const std::uint32_t r = candidate.second;  // a named variable: lambdas below capture it
       if (r == i || r == q || used_[r] || !growable(r)) continue;
       const Vec3 p2 = grid_.position(r);
       Ball ball;

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <utility>
 
 #include "g2s/error.hpp"
 
@@ -84,6 +85,12 @@ void MappedFile::release(std::size_t begin, std::size_t end) const {
   const std::size_t first = (begin + page - 1) / page * page;
   const std::size_t last = std::min(end, size_) / page * page;
   if (first < last) ::madvise(static_cast<char*>(map_) + first, last - first, MADV_DONTNEED);
+}
+
+MappedFile::MappedFile(std::string name, std::string_view bytes)
+    : name_(std::move(name)), copy_(bytes.begin(), bytes.end()) {
+  data_ = copy_.data();
+  size_ = copy_.size();
 }
 
 MappedFile::~MappedFile() {

@@ -1,5 +1,7 @@
 // Read-only view of a whole input file for the readers: mmap for regular files (no copy, the
-// page cache does the work), a read() loop for pipes and /proc-like files. Opening problems
+// page cache does the work), a read() loop for pipes and /proc-like files, or a copy of bytes
+// already in memory (the fuzz targets: an exactly sized heap buffer, so a read past the end is
+// caught by AddressSanitizer, which an mmap's page padding would hide). Opening problems
 // (missing, directory, permission) throw Error(bad_input) naming the file. A streaming reader
 // maps lazily and releases the pages it has consumed, so resident memory stays at a window
 // however large the file.
@@ -20,6 +22,7 @@ enum class MapMode { whole, stream };
 class MappedFile {
  public:
   explicit MappedFile(const std::filesystem::path& path, MapMode mode = MapMode::whole);
+  MappedFile(std::string name, std::string_view bytes);  // a copy of bytes, called `name`
   ~MappedFile();
   MappedFile(const MappedFile&) = delete;
   MappedFile& operator=(const MappedFile&) = delete;

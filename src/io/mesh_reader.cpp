@@ -8,22 +8,26 @@
 #include "io/text_util.hpp"
 
 namespace g2s {
+namespace io {
 
-IndexedMesh read_mesh(const std::filesystem::path& path) {
-  const io::MappedFile file(path);
-  if (file.size() == 0) {
-    io::fail_input(file.name(), "file is empty (expected an STL or PLY mesh)");
-  }
-  if (io::has_ply_magic(file)) {
-    const io::PlyHeader header = io::parse_ply_header(file);
+IndexedMesh read_mesh_from(const MappedFile& file) {
+  if (file.size() == 0) fail_input(file.name(), "file is empty (expected an STL or PLY mesh)");
+  if (has_ply_magic(file)) {
+    const PlyHeader header = parse_ply_header(file);
     IndexedMesh mesh;
-    io::PlyBodyRequest request;
+    PlyBodyRequest request;
     request.drop_non_finite = false;
     request.faces = &mesh.triangles;
-    mesh.xyz = io::read_ply_body(file, header, request).xyz;
+    mesh.xyz = read_ply_body(file, header, request).xyz;
     return mesh;
   }
-  return io::read_stl(file);
+  return read_stl(file);
+}
+
+}  // namespace io
+
+IndexedMesh read_mesh(const std::filesystem::path& path) {
+  return io::read_mesh_from(io::MappedFile(path));
 }
 
 }  // namespace g2s

@@ -263,6 +263,7 @@ class BodyReader {
       // Elements after the ones we need are never read: trailing data is not our business.
       if (static_cast<int>(ei) >= vertex_.element && static_cast<int>(ei) >= face_.element) break;
     }
+    result_.end = pos;
   }
 
   template <typename T, bool Swap>
@@ -531,6 +532,7 @@ class BodyReader {
       }
       if (static_cast<int>(ei) >= vertex_.element && static_cast<int>(ei) >= face_.element) break;
     }
+    result_.end = lines.position();
   }
 
   const MappedFile& file_;

@@ -3,6 +3,7 @@
 // which either collects the points (read_points) or streams them to a sink in bounded memory
 // (scan_points, for the tile store). One path, so both number and reject points alike. The CLI
 // decides what an empty cloud means; at this layer zero points is a valid answer.
+#include <algorithm>
 #include <string_view>
 
 #include "g2s/io.hpp"
@@ -12,25 +13,38 @@
 #include "io/text_util.hpp"
 
 namespace g2s {
+namespace io {
 namespace {
 
-// Reads `path` into the returned cloud (sink == nullptr) or streams it to the sink.
-PointCloud read_or_scan(const std::filesystem::path& path, const io::PointSink* sink,
-                        ReadReport& r) {
-  r = ReadReport{};
-  const io::MappedFile file(path, sink == nullptr ? io::MapMode::whole : io::MapMode::stream);
-  if (file.size() == 0) {
-    io::fail_input(file.name(), "file is empty (expected a PLY or XYZ/PTS point cloud)");
+// Bytes from `end` on that hold something: all of them in a binary body, none when an ASCII
+// body is followed only by blanks and line ends.
+std::uint64_t bytes_holding_data(const MappedFile& file, std::size_t end, bool ascii) {
+  const std::string_view rest = file.view().substr(std::min(end, file.size()));
+  if (!ascii) return rest.size();
+  for (char c : rest) {
+    if (!is_blank(c) && c != '\n') return rest.size();
   }
-  if (io::has_ply_magic(file)) {
-    const io::PlyHeader header = io::parse_ply_header(file);
-    r.format = io::ply_format_name(header.encoding);
-    r.declared = header.elements.empty() || header.find("vertex") < 0
-                     ? 0
-                     : header.elements[static_cast<std::size_t>(header.find("vertex"))].count;
-    io::PlyBodyRequest request;
+  return 0;
+}
+
+// Reads `file` into the returned cloud (sink == nullptr) or streams it to the sink.
+PointCloud read_or_scan(const MappedFile& file, const PointSink* sink, ReadReport& r) {
+  r = ReadReport{};
+  if (file.size() == 0) {
+    fail_input(file.name(), "file is empty (expected a PLY or XYZ/PTS point cloud)");
+  }
+  if (has_ply_magic(file)) {
+    const PlyHeader header = parse_ply_header(file);
+    const int vertex = header.find("vertex");
+    r.format = ply_format_name(header.encoding);
+    r.declared = vertex < 0 ? 0 : header.elements[static_cast<std::size_t>(vertex)].count;
+    PlyBodyRequest request;
     request.points = sink;
-    io::PlyBodyResult body = io::read_ply_body(file, header, request);
+    PlyBodyResult body = read_ply_body(file, header, request);
+    // Only when the vertices come last is what follows them surely not a declared element.
+    if (vertex == static_cast<int>(header.elements.size()) - 1) {
+      r.ignored_bytes = bytes_holding_data(file, body.end, header.encoding == PlyEncoding::ascii);
+    }
     PointCloud cloud;
     cloud.xyz = std::move(body.xyz);
     r.points = cloud.size() + body.streamed;
@@ -42,28 +56,33 @@ PointCloud read_or_scan(const std::filesystem::path& path, const io::PointSink* 
   for (std::size_t i = 0; i < head.size(); ++i) {
     const auto c = static_cast<unsigned char>(head[i]);
     if (c < 0x20 && c != '\t' && c != '\n' && c != '\r' && c != '\f' && c != '\v') {
-      io::fail_input(file.name(),
-                     "byte {}: binary data (byte value 0x{:02x}) in a file that is not PLY (it "
-                     "does not start with a 'ply' line); expected a PLY or an XYZ/PTS text point "
-                     "cloud",
-                     i, c);
+      fail_input(file.name(),
+                 "byte {}: binary data (byte value 0x{:02x}) in a file that is not PLY (it "
+                 "does not start with a 'ply' line); expected a PLY or an XYZ/PTS text point "
+                 "cloud",
+                 i, c);
     }
   }
-  return io::read_xyz_points(file, r, sink);
+  return read_xyz_points(file, r, sink);
 }
 
 }  // namespace
 
-PointCloud read_points(const std::filesystem::path& path, ReadReport* report) {
-  ReadReport local;
-  return read_or_scan(path, nullptr, report != nullptr ? *report : local);
+PointCloud read_points_from(const MappedFile& file, ReadReport& report) {
+  return read_or_scan(file, nullptr, report);
 }
 
-namespace io {
-
 void scan_points(const std::filesystem::path& path, const PointSink& sink, ReadReport& report) {
-  read_or_scan(path, &sink, report);
+  const MappedFile file(path, MapMode::stream);
+  read_or_scan(file, &sink, report);
 }
 
 }  // namespace io
+
+PointCloud read_points(const std::filesystem::path& path, ReadReport* report) {
+  ReadReport local;
+  const io::MappedFile file(path, io::MapMode::whole);
+  return io::read_points_from(file, report != nullptr ? *report : local);
+}
+
 }  // namespace g2s

@@ -26,6 +26,10 @@ inline constexpr std::size_t kScanChunkPoints = std::size_t{1} << 20;
 // Throws Error(bad_input) like read_points; runs already handed to the sink stay handed.
 void scan_points(const std::filesystem::path& path, const PointSink& sink, ReadReport& report);
 
+// read_points and read_mesh on an opened file (point_reader.cpp, mesh_reader.cpp).
+PointCloud read_points_from(const MappedFile& file, ReadReport& report);
+IndexedMesh read_mesh_from(const MappedFile& file);
+
 // Text XYZ/PTS/CSV points (xyz_reader.cpp). Fills report->format/points/non_finite. With a
 // sink, the points go to it in order and the result is empty; without one, they are returned.
 PointCloud read_xyz_points(const MappedFile& file, ReadReport& report, const PointSink* sink);

@@ -54,9 +54,12 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
   out.report.seeds = grown.seeds;
 
   std::vector<std::uint8_t> mine(grid.size());
+  std::uint64_t mine_count = 0;
   for (std::uint32_t k = 0; k < grid.size(); ++k) {
     mine[k] = std::binary_search(own_ids.begin(), own_ids.end(), grid.id(k));
+    mine_count += mine[k];
   }
+  out.report.duplicates_merged = own - mine_count;  // exact duplicates lie in one tile
   // Dense group numbers in order of first kept triangle: the same on every run.
   std::vector<std::uint32_t> dense(grown.triangles.size(), kNoIndex);
   for (std::size_t t = 0; t < grown.triangles.size(); ++t) {

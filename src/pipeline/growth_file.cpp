@@ -22,8 +22,8 @@ namespace {
 constexpr char kMagic[8] = {'G', '2', 'S', 'G', 'R', 'O', 'W', '\0'};
 constexpr std::uint32_t kVersion = 1;
 // magic, version, tile, fingerprint, triangles, groups, suspects, points, seeds, spacing,
-// payload checksum, header checksum. No timings: the same tile gives the same bytes.
-constexpr std::size_t kHeaderBytes = 8 + 4 + 4 + 8 * 9;
+// duplicates, payload checksum, header checksum. No timings: the same tile gives the same bytes.
+constexpr std::size_t kHeaderBytes = 8 + 4 + 4 + 8 * 10;
 
 }  // namespace
 
@@ -64,6 +64,7 @@ void write_tile_growth(const std::filesystem::path& file, std::uint32_t tile,
   h = io::put_le(h, growth.report.points);
   h = io::put_le(h, growth.report.seeds);
   h = io::put_le(h, growth.report.spacing);
+  h = io::put_le(h, growth.report.duplicates_merged);
   h = io::put_le(h, tiling::xxhash64(payload.data(), payload.size()));
   io::put_le(h, tiling::xxhash64(header, kHeaderBytes - 8));
 
@@ -112,7 +113,7 @@ TileGrowth read_tile_growth(const std::filesystem::path& file, std::uint32_t til
                     bytes.size() - kHeaderBytes, triangles, suspects));
   }
   const unsigned char* p = h + kHeaderBytes;
-  if (tiling::load_le<std::uint64_t>(h + 72) != tiling::xxhash64(p, bytes.size() - kHeaderBytes)) {
+  if (tiling::load_le<std::uint64_t>(h + 80) != tiling::xxhash64(p, bytes.size() - kHeaderBytes)) {
     throw fail("triangle checksum mismatch (the file is corrupt)");
   }
   TileGrowth g;
@@ -120,6 +121,7 @@ TileGrowth read_tile_growth(const std::filesystem::path& file, std::uint32_t til
   g.report.points = tiling::load_le<std::uint64_t>(h + 48);
   g.report.seeds = tiling::load_le<std::uint64_t>(h + 56);
   g.report.spacing = tiling::load_le<double>(h + 64);
+  g.report.duplicates_merged = tiling::load_le<std::uint64_t>(h + 72);
   g.triangles.resize(triangles);
   for (Triangle& t : g.triangles) {
     for (Index& v : t) v = tiling::load_le<Index>(p), p += 4;

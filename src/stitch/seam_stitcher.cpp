@@ -224,6 +224,7 @@ void Stitcher::add(std::size_t tile, TileGrowth growth) {
   MeshReport& r = m.out.report;
   r.points += growth.report.points;
   r.seeds += growth.report.seeds;
+  r.duplicates_merged += growth.report.duplicates_merged;
   r.seconds_grid += growth.report.seconds_grid;
   r.seconds_grow += growth.report.seconds_grow;
   r.spacing = std::max(r.spacing, growth.report.spacing);

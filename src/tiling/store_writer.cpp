@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "g2s/error.hpp"
+#include "g2s/surface_check.hpp"
 #include "g2s/tile_store.hpp"
 #include "io/readers.hpp"
 #include "tiling/store_format.hpp"
@@ -262,6 +263,10 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
                             input.string(), first.points, kNoIndex));
   }
   if (first.points == 0) bounds = TileBox{};
+  if (const std::string why = why_beyond_float(bounds.lo, bounds.hi); !why.empty()) {
+    throw Error(Exit::no_surface, fmt::format("{}: no surface can be formed: {}; nothing written",
+                                              input.string(), why));
+  }
   const std::uint64_t total = first.points;
   if (options.progress) options.progress(0, total);
 

@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# Builds the library, CLI and tests with AddressSanitizer and UndefinedBehaviorSanitizer
+# (build-asan/, RelWithDebInfo: optimised so the real-scan tests finish, with line numbers in
+# reports) and runs the whole test suite. Any sanitizer report fails its test.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/install-deps.sh
+cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DG2S_WERROR=ON \
+  -DG2S_SANITIZE=address,undefined -DG2S_BUILD_BENCH=OFF
+cmake --build build-asan -j"$(nproc)"
+export ASAN_OPTIONS=detect_leaks=1
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+ctest --test-dir build-asan --output-on-failure -j"$(nproc)"
