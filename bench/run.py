@@ -442,7 +442,7 @@ def compare_table(rows):
     for row in rows:
         if "wall_seconds" not in row:
             what = {"timeout": "timeout", "skipped": "skipped"}.get(row["kind"], f"failed (exit {row.get('exit_code')})")
-            note = f" ({row['error']})" if row["kind"] == "skipped" else ""
+            note = f" ({row['error']})" if row["kind"] in ("skipped", "timeout") else ""
             lines.append(f"| {row['cloud']} | {row['method']} | — | — | {what}{note} | — | — | — | — | — | — | — | — | — | — |")
             continue
         stats = row.get("stats") or {}
