@@ -4,7 +4,7 @@
 // comparison over commits on one machine, never asserted. Setup (clouds, grids, grown meshes)
 // is built once per process and kept out of the timed loops.
 //
-// TBB is limited to G2S_BENCH_THREADS threads (default 1, as bench/run.sh runs `g2s mesh
+// TBB is limited to G2S_BENCH_THREADS threads (default 1, as bench/run.py runs `g2s mesh
 // --threads 1`), so the numbers do not depend on how busy the other cores are; the mesher
 // benchmarks report wall-clock time (UseRealTime), so a parallel stage would still show up.
 #include <benchmark/benchmark.h>
