@@ -1,8 +1,8 @@
 // Micro-benchmarks of the flat hash grid (src/grid): building it (Morton radix sort, duplicate
-// merge, hashed cells, spacing estimate) and fixed-radius ball queries, on an evenly sampled
-// synthetic unit sphere. Times are for comparison over commits on one machine, never asserted.
-// Setup (the clouds, the grid for the query benchmark) is built once per process and kept out
-// of the timed loops.
+// merge, hashed cells, spacing estimate), fixed-radius ball queries and nearest-point queries, on
+// an evenly sampled synthetic unit sphere. Times are for comparison over commits on one machine,
+// never asserted. Setup (the clouds, the grid for the query benchmark) is built once per process
+// and kept out of the timed loops.
 #include <benchmark/benchmark.h>
 
 #include <cstdint>
@@ -62,5 +62,22 @@ void BM_BallQuery(benchmark::State& state) {
       benchmark::Counter(static_cast<double>(found), benchmark::Counter::kAvgIterations);
 }
 BENCHMARK(BM_BallQuery)->ArgName("radius_x10")->Arg(10)->Arg(20)->Arg(30);
+
+// One nearest-neighbour query per iteration on the 1M-point sphere's grid (the seed search's
+// first step: the nearest other point within 4 spacings), points taken in the same scattered
+// order as BM_BallQuery.
+void BM_Nearest(benchmark::State& state) {
+  static const g2s::HashGrid grid(sphere_points(1'000'000), {});
+  const double max_radius = 4.0 * grid.spacing();
+  std::uint32_t i = 0;
+  std::uint64_t found = 0;
+  for (auto _ : state) {
+    found += grid.nearest(i, max_radius, [](std::uint32_t) { return true; }) != g2s::kNoIndex;
+    i = (i + 7919) % grid.size();
+  }
+  benchmark::DoNotOptimize(found);
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_Nearest);
 
 }  // namespace
