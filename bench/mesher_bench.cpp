@@ -1,6 +1,7 @@
 // Micro-benchmarks of the mesher (src/pipeline, src/grow, src/cleanup) on synthetic clouds made
 // in-process: the whole mesh_tile on a 200k-point sphere and a 200k-point noisy terrain, growth
-// alone, and the non-manifold vertex pass on a grown (not yet cleaned) mesh. Times are for
+// alone, the Gabriel walk alone, and the non-manifold vertex pass on a grown (not yet cleaned)
+// mesh. Times are for
 // comparison over commits on one machine, never asserted. Setup (clouds, grids, grown meshes)
 // is built once per process and kept out of the timed loops.
 //
@@ -20,6 +21,7 @@
 #include "g2s/mesher.hpp"
 #include "g2s/synth.hpp"
 #include "grid/hash_grid.hpp"
+#include "grow/gabriel_walk.hpp"
 #include "grow/grower.hpp"
 
 namespace {
@@ -158,5 +160,45 @@ BENCHMARK(BM_NonManifold_NoisyTerrain200k)
     ->Arg(1)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+// The Gabriel walk alone, on the noisy terrain: for edges from 20,000 points to their nearest
+// neighbour, the candidates are the points within twice the edge's length of its midpoint, about
+// what the larger radius levels gather (gathered once, outside the timed loop).
+void BM_GabrielWalk_NoisyTerrain200k(benchmark::State& state) {
+  const g2s::HashGrid grid(terrain(), {});
+  struct Edge {
+    g2s::Vec3 a, b;
+    std::vector<g2s::Index> candidates;
+  };
+  std::vector<Edge> edges;
+  for (std::uint32_t i = 0; i < grid.size() && edges.size() < 20'000; i += 10) {
+    const std::uint32_t j = grid.nearest(i, 4 * grid.spacing(), [](std::uint32_t) { return true; });
+    if (j == g2s::kNoIndex) continue;
+    Edge e{grid.position(i), grid.position(j), {}};
+    const g2s::Vec3 mid = (e.a + e.b) * 0.5;
+    grid.for_each_in_ball(mid, 2 * std::max(norm(e.b - e.a), grid.spacing()),
+                          [&](std::uint32_t k, double) {
+                            if (k != i && k != j) e.candidates.push_back(k);
+                          });
+    if (!e.candidates.empty()) edges.push_back(std::move(e));
+  }
+  std::vector<g2s::Index> scratch;
+  std::uint64_t walks = 0;
+  for (auto _ : state) {
+    for (const Edge& e : edges) {
+      scratch.assign(e.candidates.begin(), e.candidates.end());
+      benchmark::DoNotOptimize(g2s::gabriel_walk(grid, e.a, e.b, (e.a + e.b) * 0.5, scratch));
+    }
+    walks += edges.size();
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(walks));
+  state.counters["candidates/edge"] = static_cast<double>([&] {
+                                        std::size_t n = 0;
+                                        for (const Edge& e : edges) n += e.candidates.size();
+                                        return n;
+                                      }()) /
+                                      static_cast<double>(edges.size());
+}
+BENCHMARK(BM_GabrielWalk_NoisyTerrain200k)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace

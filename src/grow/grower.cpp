@@ -13,6 +13,7 @@
 #include "common/edge_map.hpp"
 #include "common/union_find.hpp"
 #include "grow/bucket_queue.hpp"
+#include "grow/gabriel_walk.hpp"
 
 namespace g2s {
 namespace {
@@ -254,41 +255,6 @@ class Grower {
     excluded_.clear();
   }
 
-  // The Gabriel walk over cand_: start at the candidate nearest the edge midpoint, move to the
-  // candidate deepest inside the current smallest ball through a, b and the chosen point, stop
-  // when no candidate is inside. Co-circular ties go to the smaller index (ALGORITHM.md §1).
-  Index gabriel_walk(const Vec3& a, const Vec3& b, const Vec3& mid) {
-    std::size_t start = 0;
-    double best = 0;
-    for (std::size_t k = 0; k < cand_.size(); ++k) {
-      const double d2 = norm2(grid_.position(cand_[k]) - mid);
-      if (k == 0 || d2 < best || (d2 == best && cand_[k] < cand_[start])) start = k, best = d2;
-    }
-    Index p = cand_[start];
-    for (std::size_t step = 0; step <= cand_.size(); ++step) {
-      Ball ball;
-      if (!circumball(a, b, grid_.position(p), ball)) {
-        // (Nearly) on the line ab: no triangle. Walk on among the others.
-        cand_.erase(std::find(cand_.begin(), cand_.end(), p));
-        if (cand_.empty()) return kNoIndex;
-        p = cand_.front();
-        continue;
-      }
-      const double tol = 1e-6 * ball.radius2;
-      Index next = kNoIndex;
-      double deepest = 0;
-      for (Index q : cand_) {
-        if (q == p) continue;
-        const double depth = norm2(grid_.position(q) - ball.centre) - ball.radius2;
-        const bool inside = depth < -tol || (depth <= tol && q < p);
-        if (inside && (next == kNoIndex || depth < deepest)) next = q, deepest = depth;
-      }
-      if (next == kNoIndex) return p;
-      p = next;
-    }
-    return p;
-  }
-
   // The point to grow edge e onto, and its priority value m*(radius level) + flatness level.
   // The search balls of all levels pass through a and b with centres on the same ray, so on the
   // growing side each contains the one before: the level-1 ball is gathered first (most edges
@@ -333,7 +299,7 @@ class Grower {
         if (q.dist2 - 2 * along * q.ahead <= 0.25 * len * len) cand_.push_back(q.index);
       }
       while (!cand_.empty()) {
-        const Index p = gabriel_walk(a, b, mid);
+        const Index p = gabriel_walk(grid_, a, b, mid, cand_);
         if (p == kNoIndex) break;
         const Vec3 n_new = normalized(cross(a - b, grid_.position(p) - b));
         const double beta = std::acos(std::clamp(dot(n, n_new), -1.0, 1.0));
