@@ -29,12 +29,25 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// Everything kept so far, in global ids, with each triangle's orientation group.
+// Everything kept so far, in global ids, with each triangle's orientation group, and which
+// triangles touch each tile's points, so that a seam looks only at its tiles' triangles.
 struct KeptMesh {
   std::vector<Triangle> triangles;
   std::vector<std::uint32_t> group;
   ParityUnionFind groups;
   std::vector<Index> second_fans;
+  std::vector<std::uint32_t> tile_of;               // by global id, for the tiles added so far
+  std::vector<std::vector<std::uint32_t>> by_tile;  // tile -> triangles with a corner in it
+
+  void add(const Triangle& t, std::uint32_t g) {
+    const auto index = static_cast<std::uint32_t>(triangles.size());
+    triangles.push_back(t);
+    group.push_back(g);
+    const std::uint32_t a = tile_of[t[0]], b = tile_of[t[1]], c = tile_of[t[2]];
+    by_tile[a].push_back(index);
+    if (b != a) by_tile[b].push_back(index);
+    if (c != a && c != b) by_tile[c].push_back(index);
+  }
 };
 
 class SeamStitcher {
@@ -92,7 +105,16 @@ class SeamStitcher {
     // this one, whose positions `xyz` already holds.
     preload_.clear();
     preload_group_.clear();
-    for (std::uint32_t t = 0; t < kept.triangles.size(); ++t) {
+    // Band points lie in this tile and its earlier neighbours: only their triangles can touch
+    // the band. Taken in the order they were kept.
+    touching_.clear();
+    for (std::size_t j : earlier) {
+      touching_.insert(touching_.end(), kept.by_tile[j].begin(), kept.by_tile[j].end());
+    }
+    touching_.insert(touching_.end(), kept.by_tile[tile].begin(), kept.by_tile[tile].end());
+    std::sort(touching_.begin(), touching_.end());
+    touching_.erase(std::unique(touching_.begin(), touching_.end()), touching_.end());
+    for (std::uint32_t t : touching_) {
       const Triangle& tri = kept.triangles[t];
       if (!in_band_[tri[0]] && !in_band_[tri[1]] && !in_band_[tri[2]]) continue;
       const auto [root, parity] = kept.groups.find(kept.group[t]);
@@ -159,8 +181,7 @@ class SeamStitcher {
       }
       Triangle t = grown.triangles[k];
       if (flip) std::swap(t[1], t[2]);
-      kept.triangles.push_back({grid.id(t[0]), grid.id(t[1]), grid.id(t[2])});
-      kept.group.push_back(group);
+      kept.add({grid.id(t[0]), grid.id(t[1]), grid.id(t[2])}, group);
     }
     for (Index v : grown.second_fans) kept.second_fans.push_back(grid.id(v));
 
@@ -175,6 +196,7 @@ class SeamStitcher {
   std::vector<std::uint8_t> loaded_;
   std::vector<Index> ids_;
   std::vector<float> local_;
+  std::vector<std::uint32_t> touching_;  // kept triangles with a corner in the seam's tiles
   std::vector<Triangle> preload_;
   std::vector<std::uint32_t> preload_group_;
 };
@@ -200,6 +222,8 @@ Stitcher::Stitcher(const TileSource& source, const PipelineOptions& options) {
   impl_ = std::make_unique<Impl>(source, options);
   impl_->out.tiles = source.tiles().size();
   impl_->out.xyz.assign(3 * impl_->n, 0.0);
+  impl_->kept.tile_of.assign(impl_->n, 0);
+  impl_->kept.by_tile.resize(source.tiles().size());
 }
 
 Stitcher::~Stitcher() = default;
@@ -214,11 +238,13 @@ void Stitcher::add(std::size_t tile, TileGrowth growth) {
     if (points.ids[k] >= m.n)
       throw Error(Exit::bad_input, "tile store: a point id is out of range");
     std::copy_n(&points.xyz[3 * k], 3, &m.out.xyz[3 * std::size_t{points.ids[k]}]);
+    m.kept.tile_of[points.ids[k]] = static_cast<std::uint32_t>(tile);
   }
   const auto base = static_cast<std::uint32_t>(m.kept.groups.size());
   for (std::uint32_t k = 0; k < growth.groups; ++k) m.kept.groups.add();
-  m.kept.triangles.insert(m.kept.triangles.end(), growth.triangles.begin(), growth.triangles.end());
-  for (std::uint32_t group : growth.group) m.kept.group.push_back(base + group);
+  for (std::size_t k = 0; k < growth.triangles.size(); ++k) {
+    m.kept.add(growth.triangles[k], base + growth.group[k]);
+  }
   m.kept.second_fans.insert(m.kept.second_fans.end(), growth.second_fans.begin(),
                             growth.second_fans.end());
   MeshReport& r = m.out.report;
