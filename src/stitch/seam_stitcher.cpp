@@ -29,24 +29,21 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// Everything kept so far, in global ids, with each triangle's orientation group, and which
-// triangles touch each tile's points, so that a seam looks only at its tiles' triangles.
+// Everything kept so far, in global ids, with each triangle's orientation group. Triangles are
+// kept step by step (step i: tile i's own, then its seams), each step recording the tiles its
+// triangles' corners lie in, so a seam looks only at the steps that reached its tiles.
 struct KeptMesh {
   std::vector<Triangle> triangles;
   std::vector<std::uint32_t> group;
   ParityUnionFind groups;
   std::vector<Index> second_fans;
-  std::vector<std::uint32_t> tile_of;               // by global id, for the tiles added so far
-  std::vector<std::vector<std::uint32_t>> by_tile;  // tile -> triangles with a corner in it
+  std::vector<std::uint32_t> tile_of;                // by global id, for the tiles added so far
+  std::vector<std::size_t> step_begin;               // per step: its first triangle
+  std::vector<std::vector<std::size_t>> step_tiles;  // per step: its triangles' tiles, sorted
 
   void add(const Triangle& t, std::uint32_t g) {
-    const auto index = static_cast<std::uint32_t>(triangles.size());
     triangles.push_back(t);
     group.push_back(g);
-    const std::uint32_t a = tile_of[t[0]], b = tile_of[t[1]], c = tile_of[t[2]];
-    by_tile[a].push_back(index);
-    if (b != a) by_tile[b].push_back(index);
-    if (c != a && c != b) by_tile[c].push_back(index);
   }
 };
 
@@ -70,6 +67,9 @@ class SeamStitcher {
     for (std::size_t j : near) {
       if (j < tile) earlier.push_back(j);
     }
+    std::vector<std::size_t>& touched = kept.step_tiles[tile];
+    touched = earlier;  // tiles_near lists them in index order, all below `tile`
+    touched.push_back(tile);
     if (earlier.empty()) return 0;
 
     // The band (growable) and its context, from the tile and its neighbours' borders.
@@ -105,22 +105,30 @@ class SeamStitcher {
     // this one, whose positions `xyz` already holds.
     preload_.clear();
     preload_group_.clear();
-    // Band points lie in this tile and its earlier neighbours: only their triangles can touch
-    // the band. Taken in the order they were kept.
-    touching_.clear();
-    for (std::size_t j : earlier) {
-      touching_.insert(touching_.end(), kept.by_tile[j].begin(), kept.by_tile[j].end());
-    }
-    touching_.insert(touching_.end(), kept.by_tile[tile].begin(), kept.by_tile[tile].end());
-    std::sort(touching_.begin(), touching_.end());
-    touching_.erase(std::unique(touching_.begin(), touching_.end()), touching_.end());
-    for (std::uint32_t t : touching_) {
-      const Triangle& tri = kept.triangles[t];
-      if (!in_band_[tri[0]] && !in_band_[tri[1]] && !in_band_[tri[2]]) continue;
-      const auto [root, parity] = kept.groups.find(kept.group[t]);
-      preload_.push_back(parity ? Triangle{tri[0], tri[2], tri[1]} : tri);
-      preload_group_.push_back(root);
-      for (Index v : tri) take(v, in_band_[v], &xyz[3 * std::size_t{v}]);
+    // Band points lie in this tile and its earlier neighbours: only the steps that touched one
+    // of those tiles kept triangles that can touch the band. Taken in the order they were kept.
+    const std::size_t end = kept.triangles.size();
+    for (std::size_t step = 0; step <= tile; ++step) {
+      const std::vector<std::size_t>& other = kept.step_tiles[step];
+      bool shared = false;
+      for (std::size_t a = 0, b = 0; a < other.size() && b < touched.size() && !shared;) {
+        shared = other[a] == touched[b];
+        if (other[a] < touched[b]) {
+          ++a;
+        } else {
+          ++b;
+        }
+      }
+      if (!shared) continue;
+      const std::size_t last = step < tile ? kept.step_begin[step + 1] : end;
+      for (std::size_t t = kept.step_begin[step]; t < last; ++t) {
+        const Triangle& tri = kept.triangles[t];
+        if (!in_band_[tri[0]] && !in_band_[tri[1]] && !in_band_[tri[2]]) continue;
+        const auto [root, parity] = kept.groups.find(kept.group[t]);
+        preload_.push_back(parity ? Triangle{tri[0], tri[2], tri[1]} : tri);
+        preload_group_.push_back(root);
+        for (Index v : tri) take(v, in_band_[v], &xyz[3 * std::size_t{v}]);
+      }
     }
 
     const HashGrid grid(local_, ids_);
@@ -182,7 +190,11 @@ class SeamStitcher {
       Triangle t = grown.triangles[k];
       if (flip) std::swap(t[1], t[2]);
       kept.add({grid.id(t[0]), grid.id(t[1]), grid.id(t[2])}, group);
+      // A corner taken from a preloaded triangle can lie in a tile beyond this seam's.
+      for (Index v : kept.triangles.back()) touched.push_back(kept.tile_of[v]);
     }
+    std::sort(touched.begin(), touched.end());
+    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
     for (Index v : grown.second_fans) kept.second_fans.push_back(grid.id(v));
 
     for (Index id : ids_) loaded_[id] = in_band_[id] = 0;
@@ -196,7 +208,6 @@ class SeamStitcher {
   std::vector<std::uint8_t> loaded_;
   std::vector<Index> ids_;
   std::vector<float> local_;
-  std::vector<std::uint32_t> touching_;  // kept triangles with a corner in the seam's tiles
   std::vector<Triangle> preload_;
   std::vector<std::uint32_t> preload_group_;
 };
@@ -223,7 +234,8 @@ Stitcher::Stitcher(const TileSource& source, const PipelineOptions& options) {
   impl_->out.tiles = source.tiles().size();
   impl_->out.xyz.assign(3 * impl_->n, 0.0);
   impl_->kept.tile_of.assign(impl_->n, 0);
-  impl_->kept.by_tile.resize(source.tiles().size());
+  impl_->kept.step_begin.assign(source.tiles().size(), 0);
+  impl_->kept.step_tiles.resize(source.tiles().size());
 }
 
 Stitcher::~Stitcher() = default;
@@ -240,6 +252,7 @@ void Stitcher::add(std::size_t tile, TileGrowth growth) {
     std::copy_n(&points.xyz[3 * k], 3, &m.out.xyz[3 * std::size_t{points.ids[k]}]);
     m.kept.tile_of[points.ids[k]] = static_cast<std::uint32_t>(tile);
   }
+  m.kept.step_begin[tile] = m.kept.triangles.size();
   const auto base = static_cast<std::uint32_t>(m.kept.groups.size());
   for (std::uint32_t k = 0; k < growth.groups; ++k) m.kept.groups.add();
   for (std::size_t k = 0; k < growth.triangles.size(); ++k) {
