@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "g2s/io.hpp"
+#include "temp_folder.hpp"
 
 namespace {
 
@@ -104,20 +105,6 @@ double json_number(const std::string& json, const std::string& key) {
 
 class BadInput : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "g2s-bad-input-XXXXXX").string();
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override {
-    std::error_code ec;
-    for (const auto& entry : fs::recursive_directory_iterator(dir_, ec)) {
-      fs::permissions(entry.path(), fs::perms::owner_all, fs::perm_options::add, ec);
-    }
-    fs::permissions(dir_, fs::perms::owner_all, fs::perm_options::add, ec);
-    fs::remove_all(dir_, ec);
-  }
-
   fs::path write(const std::string& name, std::string_view bytes) {
     const fs::path path = dir_ / name;
     std::ofstream out(path, std::ios::binary);
@@ -181,7 +168,8 @@ class BadInput : public ::testing::Test {
 
   fs::path out() const { return dir_ / "mesh.ply"; }
 
-  fs::path dir_;
+  g2s::test_support::TempFolder folder_{"g2s-bad-input"};
+  const fs::path dir_ = folder_.path();
 };
 
 TEST_F(BadInput, EmptyFileIsBadInput) {

@@ -24,6 +24,7 @@
 #include "g2s/io.hpp"
 #include "io/mapped_file.hpp"
 #include "io/readers.hpp"
+#include "temp_folder.hpp"
 
 namespace {
 
@@ -33,23 +34,14 @@ using g2s::Exit;
 // A fresh folder per test, removed afterwards.
 class IoTempDir : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "g2s-io-read-XXXXXX").string();
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::permissions(dir_, fs::perms::owner_all, fs::perm_options::add, ec);
-    fs::remove_all(dir_, ec);
-  }
   fs::path write(const std::string& name, std::string_view bytes) {
     const fs::path path = dir_ / name;
     std::ofstream out(path, std::ios::binary);
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
     return path;
   }
-  fs::path dir_;
+  g2s::test_support::TempFolder folder_{"g2s-io-read"};
+  const fs::path dir_ = folder_.path();
 };
 
 template <typename F>

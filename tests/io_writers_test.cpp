@@ -25,6 +25,7 @@
 
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
+#include "temp_folder.hpp"
 
 namespace {
 
@@ -33,23 +34,14 @@ using g2s::Exit;
 
 class IoWriteDir : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "g2s-io-write-XXXXXX").string();
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::permissions(dir_, fs::perms::owner_all, fs::perm_options::add, ec);
-    fs::remove_all(dir_, ec);
-  }
   std::vector<std::string> entries() const {
     std::vector<std::string> names;
     for (const auto& e : fs::directory_iterator(dir_))
       names.push_back(e.path().filename().string());
     return names;
   }
-  fs::path dir_;
+  g2s::test_support::TempFolder folder_{"g2s-io-write"};
+  const fs::path dir_ = folder_.path();
 };
 
 template <typename F>

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "g2s/synth.hpp"
+#include "temp_folder.hpp"
 
 namespace {
 
@@ -25,15 +26,6 @@ namespace fs = std::filesystem;
 
 class PipelineFaults : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("g2s-faults-" + std::to_string(::getpid()) + "-" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   void make_cloud(std::uint64_t points) const {
     g2s::SynthOptions o;
     o.shape = g2s::SynthShape::torus;
@@ -103,7 +95,8 @@ class PipelineFaults : public ::testing::Test {
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   }
 
-  fs::path dir_;
+  g2s::test_support::TempFolder folder_{"g2s-faults"};
+  const fs::path dir_ = folder_.path();
 };
 
 // ulimit -f counts 1024-byte blocks; SIGXFSZ is ignored so the write fails with EFBIG instead.

@@ -18,6 +18,7 @@
 #include "g2s/pipeline.hpp"
 #include "g2s/stats.hpp"
 #include "g2s/synth.hpp"
+#include "temp_folder.hpp"
 
 namespace {
 
@@ -26,11 +27,6 @@ namespace fs = std::filesystem;
 class Stages : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("g2s-stages-" + std::to_string(::getpid()) + "-" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
     g2s::SynthOptions o;
     o.shape = g2s::SynthShape::torus;
     o.points = 30000;
@@ -38,7 +34,6 @@ class Stages : public ::testing::Test {
     cloud_ = (dir_ / "torus.ply").string();
     g2s::write_synthetic_cloud(cloud_, o);
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
   // Runs the CLI in the test folder; returns its exit code, stderr in `err`.
   int run(const std::string& args, std::string* err = nullptr) const {
@@ -54,7 +49,8 @@ class Stages : public ::testing::Test {
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   }
 
-  fs::path dir_;
+  g2s::test_support::TempFolder folder_{"g2s-stages"};
+  const fs::path dir_ = folder_.path();
   std::string cloud_;
 };
 

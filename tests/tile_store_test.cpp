@@ -31,6 +31,7 @@
 #include "g2s/io.hpp"
 #include "g2s/synth.hpp"
 #include "io/readers.hpp"
+#include "temp_folder.hpp"
 #include "tiling/xxhash64.hpp"
 
 namespace {
@@ -40,15 +41,6 @@ using g2s::Exit;
 
 class TileStoreTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "g2s-tile-store-XXXXXX").string();
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
   fs::path write(const std::string& name, std::string_view bytes) {
     const fs::path path = dir_ / name;
     std::ofstream out(path, std::ios::binary);
@@ -82,7 +74,8 @@ class TileStoreTest : public ::testing::Test {
     g2s::build_tile_store(input, store, options);
     return store;
   }
-  fs::path dir_;
+  g2s::test_support::TempFolder folder_{"g2s-tile-store"};
+  const fs::path dir_ = folder_.path();
 };
 
 std::string read_bytes(const fs::path& path) {
@@ -412,7 +405,6 @@ TEST_F(TileStoreTest, ConcurrentLoadsAgree) {
 class TileStoreDamage : public TileStoreTest {
  protected:
   void SetUp() override {
-    TileStoreTest::SetUp();
     const fs::path input = synthetic("sphere.ply", g2s::SynthShape::sphere, 5000);
     store_ = build(input, "s.tiles", 1000, true);
     bytes_ = read_bytes(store_);

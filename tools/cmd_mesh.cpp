@@ -14,7 +14,6 @@
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
 #include "g2s/pipeline.hpp"
-#include "g2s/surface_check.hpp"
 #include "g2s/tile_store.hpp"
 #include "mesh_output.hpp"
 #include "progress.hpp"
@@ -54,19 +53,6 @@ void print_input_notes(const std::string& input, const ReadReport& report) {
                "declares fewer points than the file holds, or trailing data)\n",
                input, report.ignored_bytes, report.declared);
   }
-}
-
-// Clouds up to this size are checked for being able to form a surface at all before meshing
-// (all points the same, two, on one line, beyond float's range); it needs them all in memory.
-constexpr std::uint64_t kCheckedWhole = std::uint64_t{1} << 22;
-
-[[noreturn]] void no_surface(const std::string& input, const std::string& why,
-                             std::uint64_t non_finite) {
-  const std::string dropped =
-      non_finite > 0 ? fmt::format(" ({} points with NaN or Inf coordinates dropped)", non_finite)
-                     : "";
-  throw Error(Exit::no_surface, fmt::format("{}: no surface can be formed: {}{}; nothing written",
-                                            input, why, dropped));
 }
 
 // Each tile is meshed in float around its centre, so a tile far wider than its sampling (a
@@ -116,16 +102,6 @@ void run_mesh(MeshArgs& args) {
   if (read.format.empty()) read = store.input_report();
   run.non_finite = read.non_finite;
   run.ignored_bytes = read.ignored_bytes;
-  if (store.point_count() <= kCheckedWhole) {
-    PointCloud cloud;
-    for (std::size_t t = 0; t < store.tiles().size(); ++t) {
-      const TilePoints points = store.load(t);
-      cloud.xyz.insert(cloud.xyz.end(), points.xyz.begin(), points.xyz.end());
-    }
-    if (const std::string why = why_no_surface(cloud); !why.empty()) {
-      no_surface(args.input, why, read.non_finite);
-    }
-  }
   if (!args.out.quiet) print_input_notes(args.input, read);
   args.options.threads = args.threads;
   args.options.progress = [&](std::uint64_t done, std::uint64_t total) {
@@ -133,13 +109,7 @@ void run_mesh(MeshArgs& args) {
   };
   PipelineMesh mesh = mesh_tiles(store, args.options);
   progress.clear();
-  if (mesh.triangles.empty()) {
-    no_surface(args.input,
-               fmt::format("no triangle found among {} points (too sparse for --max-radius {}?)",
-                           store.point_count(), args.options.mesh.max_radius),
-               read.non_finite);
-  }
-  if (!args.out.quiet) {
+  if (!args.out.quiet && !mesh.triangles.empty()) {
     warn_if_local_frame_rounds(args.input, store);
     if (mesh.report.duplicates_merged > 0) {
       fmt::print(stderr,

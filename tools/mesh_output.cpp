@@ -10,6 +10,7 @@
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
 #include "g2s/stats.hpp"
+#include "g2s/surface_check.hpp"
 #include "progress.hpp"
 
 namespace g2s::cli {
@@ -36,10 +37,18 @@ void warn_if_stl_rounds(const std::string& output, const std::vector<double>& xy
 
 void write_and_report(PipelineMesh& mesh, const OutputArgs& args, const RunFacts& facts) {
   if (mesh.triangles.empty()) {
-    throw Error(Exit::no_surface,
-                fmt::format("{}: no surface can be formed: no triangle found among {} points "
-                            "(too few, on one line, or too sparse); nothing written",
-                            facts.input, mesh.report.points));
+    // Say why, from the positions the pipeline holds: degenerate clouds by name, else sparse.
+    std::string why = why_no_surface(PointCloud{mesh.xyz});
+    if (why.empty()) {
+      why = fmt::format("no triangle found among {} points (too sparse for --max-radius?)",
+                        mesh.report.points);
+    }
+    const std::string dropped =
+        facts.non_finite > 0
+            ? fmt::format(" ({} points with NaN or Inf coordinates dropped)", facts.non_finite)
+            : "";
+    throw Error(Exit::no_surface, fmt::format("{}: no surface can be formed: {}{}; nothing written",
+                                              facts.input, why, dropped));
   }
   const MeshFormat format = mesh_format_for(args.output, args.ascii);
   if (!args.quiet && format != MeshFormat::ply_binary) {

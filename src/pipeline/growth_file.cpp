@@ -7,12 +7,11 @@
 #include <fmt/core.h>
 
 #include <cstring>
-#include <fstream>
-#include <iterator>
 
 #include "g2s/error.hpp"
 #include "g2s/pipeline.hpp"
 #include "io/le_bytes.hpp"
+#include "io/mapped_file.hpp"
 #include "tiling/store_format.hpp"
 #include "tiling/xxhash64.hpp"
 
@@ -79,14 +78,14 @@ TileGrowth read_tile_growth(const std::filesystem::path& file, std::uint32_t til
   auto fail = [&](const std::string& what) {
     return Error(Exit::bad_input, fmt::format("{}: {}", file.string(), what));
   };
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw fail("cannot open the tile growth (was the tile grown?)");
-  const std::vector<char> bytes((std::istreambuf_iterator<char>(in)),
-                                std::istreambuf_iterator<char>());
-  if (bytes.size() < kHeaderBytes || std::memcmp(bytes.data(), kMagic, 8) != 0) {
+  if (!std::filesystem::is_regular_file(file)) {
+    throw fail("no tile growth there (was the tile grown?)");
+  }
+  const io::MappedFile bytes(file);
+  if (bytes.size() < kHeaderBytes || std::memcmp(bytes.bytes(), kMagic, 8) != 0) {
     throw fail("not a g2s tile growth file (or truncated before its header ends)");
   }
-  const auto* h = reinterpret_cast<const unsigned char*>(bytes.data());
+  const unsigned char* h = bytes.bytes();
   if (tiling::load_le<std::uint64_t>(h + kHeaderBytes - 8) !=
       tiling::xxhash64(h, kHeaderBytes - 8)) {
     throw fail("header checksum mismatch (the file is corrupt)");
