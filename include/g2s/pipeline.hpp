@@ -44,6 +44,9 @@ struct TileGrowth {
   // and corners of triangles left out because they reach into the halo.
   std::vector<Index> second_fans;
   MeshReport report;
+  // The tile's own points as grow_tile loaded them, handed on so the stitcher of the same
+  // process does not load them again (growth files leave them out: `g2s stitch` loads them).
+  TilePoints points;
 };
 
 struct PipelineOptions {

@@ -23,6 +23,8 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
 
   TilePoints points = source.load(tile);
   const std::size_t own = points.size();
+  TileGrowth out;
+  out.points = points;
   for (std::size_t j : tiles_near(tiles, tile, halo)) {
     const TilePoints border = source.load_border(j, halo);
     for (std::size_t k = 0; k < border.size(); ++k) {
@@ -41,7 +43,6 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
   std::vector<Index> own_ids(points.ids.begin(), points.ids.begin() + static_cast<long>(own));
   std::sort(own_ids.begin(), own_ids.end());
 
-  TileGrowth out;
   const HashGrid grid(local, points.ids);
   out.report.points = own;
   out.report.spacing = grid.spacing();

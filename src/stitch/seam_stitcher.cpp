@@ -245,7 +245,8 @@ void Stitcher::add(std::size_t tile, TileGrowth growth) {
   if (tile != m.next) throw Error(Exit::failure, "stitch: tiles must come in index order");
   ++m.next;
   const auto start = std::chrono::steady_clock::now();
-  const TilePoints points = m.source.load(tile);
+  const TilePoints points =
+      growth.points.size() == growth.report.points ? std::move(growth.points) : m.source.load(tile);
   for (std::size_t k = 0; k < points.size(); ++k) {
     if (points.ids[k] >= m.n)
       throw Error(Exit::bad_input, "tile store: a point id is out of range");
