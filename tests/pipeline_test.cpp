@@ -30,7 +30,8 @@ g2s::MeshStats stats_of(const g2s::PointCloud& cloud, const g2s::PipelineMesh& m
 void print(const char* what, const g2s::MeshStats& s, const g2s::PipelineMesh& mesh) {
   std::printf(
       "%s: %llu tiles, %llu triangles (%llu stitched), boundary %llu, holes %llu, "
-      "coverage %.4f, nm-edges %llu, nm-vertices %llu, conflicts %llu, dup %llu\n",
+      "coverage %.4f, nm-edges %llu, nm-vertices %llu, conflicts %llu, dup %llu, peak live "
+      "points %llu, dropped %llu, unjudged %llu\n",
       what, static_cast<unsigned long long>(mesh.tiles),
       static_cast<unsigned long long>(s.triangles),
       static_cast<unsigned long long>(mesh.triangles_stitched),
@@ -38,7 +39,10 @@ void print(const char* what, const g2s::MeshStats& s, const g2s::PipelineMesh& m
       s.coverage, static_cast<unsigned long long>(s.non_manifold_edges),
       static_cast<unsigned long long>(s.non_manifold_vertices),
       static_cast<unsigned long long>(s.orientation_conflicts),
-      static_cast<unsigned long long>(s.duplicate_triangles));
+      static_cast<unsigned long long>(s.duplicate_triangles),
+      static_cast<unsigned long long>(mesh.peak_live_points),
+      static_cast<unsigned long long>(mesh.seam_triangles_dropped),
+      static_cast<unsigned long long>(mesh.vertices_unjudged));
 }
 
 void expect_clean(const g2s::MeshStats& s) {
@@ -104,6 +108,15 @@ TEST_P(RealScanTiled, SmallTilesStayWithinTwoPercentOfOneTile) {
   expect_clean(s1);
   expect_clean(st);
   expect_close_to(st, s1, c.boundary_ratio);
+  // The stitcher's reach and release margin were wide enough: no seam triangle had to be left
+  // out, and every fan was judged whole.
+  EXPECT_EQ(tiled.seam_triangles_dropped, 0u);
+  EXPECT_EQ(tiled.vertices_unjudged, 0u);
+  // Only a band along the open seams was held, not the cloud (the smallest scans have tiles
+  // narrower than the band).
+  if (cloud.size() > 100000) {
+    EXPECT_LT(tiled.peak_live_points, cloud.size() / 4);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(SharedData, RealScanTiled,

@@ -25,7 +25,8 @@ struct MeshArgs {
   std::string input;
   OutputArgs out;
   int threads = 0;
-  std::uint64_t tile_points = std::uint64_t{1} << 20;
+  std::uint64_t memory = 0;       // 0: default_memory_budget()
+  std::uint64_t tile_points = 0;  // 0: from the memory plan
   std::string keep_store;
   bool compress = false;
   PipelineOptions options;
@@ -88,10 +89,14 @@ void run_mesh(MeshArgs& args) {
         fmt::format(".{}.store-{}", output.filename().string(), static_cast<long>(getpid())));
     store_path = temporary->path();
   }
+  const std::uint64_t budget = args.memory > 0 ? args.memory : default_memory_budget();
+  const MemoryPlan plan = plan_memory(budget, args.threads);
+  args.out.memory = budget;
   ReadReport read;
   if (temporary || !reusable(store_path, args.input)) {
     TileStoreOptions tiling;
-    tiling.tile_points = args.tile_points;
+    tiling.tile_points = args.tile_points > 0 ? args.tile_points : plan.tile_points;
+    tiling.round_points = std::max(plan.round_points, tiling.tile_points);
     tiling.compress = args.compress;
     tiling.progress = [&](std::uint64_t done, std::uint64_t total) {
       progress.stage("tiling", total ? static_cast<double>(done) / static_cast<double>(total) : 1);
@@ -104,21 +109,27 @@ void run_mesh(MeshArgs& args) {
   run.ignored_bytes = read.ignored_bytes;
   if (!args.out.quiet) print_input_notes(args.input, read);
   args.options.threads = args.threads;
+  args.options.tiles_in_flight = plan.tiles_in_flight;
   args.options.progress = [&](std::uint64_t done, std::uint64_t total) {
     progress.stage("meshing", static_cast<double>(done) / static_cast<double>(total));
   };
-  PipelineMesh mesh = mesh_tiles(store, args.options);
-  progress.clear();
-  if (!args.out.quiet && !mesh.triangles.empty()) {
-    warn_if_local_frame_rounds(args.input, store);
-    if (mesh.report.duplicates_merged > 0) {
-      fmt::print(stderr,
-                 "g2s: note: {}: {} duplicate points merged (equal in the mesher's float "
-                 "coordinates)\n",
-                 args.input, mesh.report.duplicates_merged);
-    }
-  }
-  write_and_report(mesh, args.out, run);
+  write_and_report(
+      store,
+      [&](MeshSink& sink) {
+        const PipelineSummary summary = mesh_tiles(store, args.options, sink);
+        progress.clear();
+        if (!args.out.quiet && summary.triangles > 0) {
+          warn_if_local_frame_rounds(args.input, store);
+          if (summary.report.duplicates_merged > 0) {
+            fmt::print(stderr,
+                       "g2s: note: {}: {} duplicate points merged (equal in the mesher's float "
+                       "coordinates)\n",
+                       args.input, summary.report.duplicates_merged);
+          }
+        }
+        return summary;
+      },
+      args.out, run);
 }
 
 }  // namespace
@@ -164,9 +175,14 @@ void add_mesh_command(CLI::App& app) {
   add_output_options(*cmd, args->out);
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--memory", args->memory,
+                  "Memory budget, e.g. 512M or 4G (default: half the machine's RAM): sets the "
+                  "tile size and the tiles in flight; the peak resident memory stays below it")
+      ->transform(CLI::AsSizeValue(false));
   cmd->add_option("--tile-points", args->tile_points,
-                  "Largest number of points in a tile (default 1048576): the cloud is cut into "
-                  "tiles grown in parallel and stitched at the seams")
+                  "Largest number of points in a tile (default: from --memory, at most "
+                  "1048576): the cloud is cut into tiles grown in parallel and stitched at the "
+                  "seams")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--keep-store", args->keep_store,
                   "Keep the tile store at this path (reused by the next run while it is newer "

@@ -120,17 +120,25 @@ void run_stitch(StitchArgs& args) {
   facts.non_finite = store.input_report().non_finite;
   const std::uint64_t fingerprint = source_fingerprint(store);
   const std::filesystem::path folder = growth_folder(args.store, args.grown);
-  std::vector<TileGrowth> growths(store.tiles().size());
-  for (std::size_t t = 0; t < growths.size(); ++t) {
-    growths[t] =
-        read_tile_growth(growth_file(folder, t), static_cast<std::uint32_t>(t), fingerprint);
+  const std::size_t tiles = store.tiles().size();
+  // Every growth file is checked before anything is stitched: a missing or corrupt one fails
+  // the run at once, not after minutes of stitching.
+  for (std::size_t t = 0; t < tiles; ++t) {
+    read_tile_growth(growth_file(folder, t), static_cast<std::uint32_t>(t), fingerprint);
   }
-  args.options.progress = [&](std::uint64_t done, std::uint64_t total) {
-    progress.stage("stitching", static_cast<double>(done) / static_cast<double>(total));
-  };
-  PipelineMesh mesh = stitch_tiles(store, std::move(growths), args.options);
-  progress.clear();
-  write_and_report(mesh, args.out, facts);
+  write_and_report(
+      store,
+      [&](MeshSink& sink) {
+        Stitcher stitcher(store, args.options, sink);
+        for (std::size_t t = 0; t < tiles; ++t) {
+          stitcher.add(t, read_tile_growth(growth_file(folder, t), static_cast<std::uint32_t>(t),
+                                           fingerprint));
+          progress.stage("stitching", static_cast<double>(t + 1) / static_cast<double>(tiles));
+        }
+        progress.clear();
+        return stitcher.finish();
+      },
+      args.out, facts);
 }
 
 }  // namespace

@@ -1,9 +1,10 @@
-// Shared by `g2s mesh` and `g2s stitch`: write the finished mesh and print the summary line (or
-// the JSON object) with the mesh's defects.
+// Shared by `g2s mesh` and `g2s stitch`: stream the pipeline's mesh to the output and print the
+// summary line (or the JSON object) with the mesh's defects.
 #pragma once
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include "g2s/pipeline.hpp"
@@ -16,17 +17,23 @@ struct OutputArgs {
   bool quiet = false;
   bool json = false;
   bool no_stats = false;
+  // Bytes measuring the written mesh may take (it is read back whole); 0: no limit.
+  std::uint64_t memory = 0;
 };
 
 // What the summary names besides the mesh itself.
 struct RunFacts {
-  std::string input;             // the cloud or store meshed
+  std::string input;                // the cloud or store meshed
   std::uint64_t non_finite = 0;     // points the reader dropped
   std::uint64_t ignored_bytes = 0;  // after a PLY's declared vertices
   std::chrono::steady_clock::time_point start;
 };
 
-// Writes `mesh` to args.output (atomically; Error(bad_input) if it has no triangle) and reports.
-void write_and_report(PipelineMesh& mesh, const OutputArgs& args, const RunFacts& facts);
+// Runs the pipeline (`run` feeds the sink it is given) into args.output, written atomically,
+// then reports. With no triangle nothing is written: Error(no_surface) says why, from the
+// points of `source`.
+void write_and_report(const TileSource& source,
+                      const std::function<PipelineSummary(MeshSink&)>& run, const OutputArgs& args,
+                      const RunFacts& facts);
 
 }  // namespace g2s::cli

@@ -3,12 +3,15 @@
 // failure throws g2s::Error(Exit::write_failed) and leaves no file at the target path.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "g2s/mesh_sink.hpp"
 #include "g2s/types.hpp"
 
 namespace g2s {
@@ -127,6 +130,30 @@ class StlWriter {
 // thrown before anything is written.
 void write_mesh(const std::filesystem::path& target, std::span<const double> xyz,
                 std::span<const Triangle> triangles, MeshFormat format);
+
+// The tiled pipeline's writer: a MeshSink that spills triangles to a temporary beside the target
+// as they come, and at finish() writes the target in `format` with the groups' flips applied,
+// atomically (as write_mesh would: PLY indexed, float unless a coordinate would not survive).
+// Disk: the spill (40 bytes a triangle for STL; 16 a triangle and 24 a vertex for PLY) and the
+// output exist together at the end. With no triangle, or destroyed unfinished, it leaves no file.
+class MeshStreamWriter final : public MeshSink {
+ public:
+  MeshStreamWriter(const std::filesystem::path& target, MeshFormat format);
+  ~MeshStreamWriter() override;
+  void vertex(Index id, const double xyz[3]) override;
+  void triangle(const Triangle& corners, const std::array<const double*, 3>& xyz,
+                std::uint32_t group) override;
+  void finish(std::span<const std::uint8_t> flip) override;
+  std::uint64_t triangles() const;
+  // For the STL rounding warning: the largest |coordinate| of the vertices, and the most
+  // rounding to float moves one.
+  double largest_coordinate() const;
+  double float_rounding() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 // Writes points as binary little-endian PLY with float x, y, z, streamed: begin with the
 // count, add points, finish() checks the count and renames into place. A count mismatch throws

@@ -12,6 +12,7 @@
 #include <span>
 #include <vector>
 
+#include "g2s/mesh_sink.hpp"
 #include "g2s/mesher.hpp"
 #include "g2s/tile_store.hpp"
 
@@ -58,6 +59,9 @@ struct PipelineOptions {
   double band_spacings = 6.0;
   // Points, in Gabriel order, a seam edge tries after its Gabriel point fails to join.
   int stitch_retries = 4;
+  // Tiles grown but not yet stitched, at most (their triangles wait in memory); 0: two per
+  // thread.
+  std::size_t tiles_in_flight = 0;
   // Called with (tiles stitched, tiles in total), from one thread at a time, after each tile;
   // may be empty. mesh.progress is not used.
   std::function<void(std::uint64_t, std::uint64_t)> progress;
@@ -66,35 +70,47 @@ struct PipelineOptions {
 // Grows one tile with its halo. Deterministic; independent of the other tiles.
 TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineOptions& options);
 
-struct PipelineMesh {
-  std::vector<Triangle> triangles;  // global ids, oriented, manifold
-  std::vector<double> xyz;          // 3 doubles per global id (points no triangle uses included)
+// What a pipeline run did, besides the mesh itself.
+struct PipelineSummary {
   MeshReport report;
   std::uint64_t tiles = 0;
+  std::uint64_t triangles = 0;  // handed to the sink
+  std::uint64_t vertices = 0;
   std::uint64_t triangles_stitched = 0;
+  // Seam triangles left out because a corner was already finished (a triangle longer than the
+  // stitcher's reach; 0 unless --max-radius is far above the band width).
+  std::uint64_t seam_triangles_dropped = 0;
+  // Vertices whose fan a late deletion may have split after some of their triangles had left
+  // (beyond the release margin; 0 in every test cloud).
+  std::uint64_t vertices_unjudged = 0;
+  // The most points the stitcher held at once: the band of unfinished seams, not the cloud.
+  std::uint64_t peak_live_points = 0;
   double seconds_stitch = 0.0;
 };
 
-// The seam stitcher, fed tile by tile in index order (as tiles finish growing), then finished:
-// the global non-manifold pass and the orientation of the components.
+// The whole mesh in memory (tests, small clouds): triangles in global ids, oriented, manifold.
+struct PipelineMesh : PipelineSummary {
+  std::vector<Triangle> triangles;
+  std::vector<double> xyz;  // 3 doubles per global id (points no triangle uses are zero)
+};
+
+// The seam stitcher and the global clean-up, fed tile by tile in index order (as tiles finish
+// growing). A vertex is finished once every tile that could still touch it has been stitched:
+// then its non-manifold fans are removed, and each triangle whose corners are all finished goes
+// to the sink and leaves memory. finish() decides the orientation of the groups.
 class Stitcher {
  public:
-  Stitcher(const TileSource& source, const PipelineOptions& options);
+  Stitcher(const TileSource& source, const PipelineOptions& options, MeshSink& sink);
   ~Stitcher();
   Stitcher(const Stitcher&) = delete;
   Stitcher& operator=(const Stitcher&) = delete;
   void add(std::size_t tile, TileGrowth growth);  // tile = 0, 1, 2, ...
-  PipelineMesh finish();
+  PipelineSummary finish();
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
-
-// Stitches the seams between grown tiles, removes non-manifold vertices and orients the
-// components. growths[i] is grow_tile(source, i, options).
-PipelineMesh stitch_tiles(const TileSource& source, std::vector<TileGrowth> growths,
-                          const PipelineOptions& options);
 
 // The tile store's identity for growth files: a hash of its tile table.
 std::uint64_t source_fingerprint(const TileSource& source);
@@ -107,7 +123,26 @@ void write_tile_growth(const std::filesystem::path& file, std::uint32_t tile,
 TileGrowth read_tile_growth(const std::filesystem::path& file, std::uint32_t tile,
                             std::uint64_t fingerprint);
 
-// All stages in one process: grow_tile over every tile as TBB tasks, then stitch_tiles.
+// All stages in one process: grow_tile over every tile as TBB tasks (at most
+// options.tiles_in_flight grown and not yet stitched), stitched in order into `sink`.
+PipelineSummary mesh_tiles(const TileSource& source, const PipelineOptions& options,
+                           MeshSink& sink);
+
+// The same, collecting the mesh in memory.
 PipelineMesh mesh_tiles(const TileSource& source, const PipelineOptions& options);
+
+// How `g2s mesh --memory` spends a budget of bytes (peak resident memory, as /usr/bin/time -v
+// reports it): the largest tile, the tiles grown and waiting at once, and the points the tile
+// store's writer sorts per round. Per-point costs measured on the synthetic torus, with the
+// margin docs/pipeline.md gives; a budget too small for a workable tile throws Error(usage).
+struct MemoryPlan {
+  std::uint64_t tile_points = 0;
+  std::size_t tiles_in_flight = 0;
+  std::uint64_t round_points = 0;
+};
+MemoryPlan plan_memory(std::uint64_t budget_bytes, int threads);
+
+// The default budget: half of the machine's physical memory.
+std::uint64_t default_memory_budget();
 
 }  // namespace g2s

@@ -19,12 +19,16 @@ NonManifoldReport remove_non_manifold_vertices(std::vector<Triangle>& triangles,
   return remove_non_manifold_vertices_at(triangles, vertex_count, all);
 }
 
-NonManifoldReport remove_non_manifold_vertices_at(std::vector<Triangle>& triangles,
-                                                  std::size_t vertex_count,
-                                                  std::span<const Index> suspects) {
+// finished empty: every vertex is finished.
+NonManifoldReport mark_non_manifold_fans(std::span<const Triangle> triangles,
+                                         std::size_t vertex_count, std::span<const Index> suspects,
+                                         std::span<const std::uint8_t> finished,
+                                         std::vector<std::uint8_t>& dead,
+                                         std::vector<Index>& deferred) {
   NonManifoldReport report;
-  if (suspects.empty()) return report;
   const std::size_t nt = triangles.size();
+  dead.assign(nt, 0);
+  if (suspects.empty()) return report;
   // CSR: vertex -> incident triangles.
   std::vector<std::uint32_t> start(vertex_count + 1, 0);
   for (const Triangle& t : triangles) {
@@ -38,7 +42,6 @@ NonManifoldReport remove_non_manifold_vertices_at(std::vector<Triangle>& triangl
       for (Index v : triangles[t]) star[fill[v]++] = t;
     }
   }
-  std::vector<std::uint8_t> dead(nt, 0);
   // Suspects are examined in index order whatever order they arose in.
   std::vector<std::uint8_t> queued(vertex_count, 0);
   std::vector<Index> work(suspects.begin(), suspects.end());
@@ -101,16 +104,31 @@ NonManifoldReport remove_non_manifold_vertices_at(std::vector<Triangle>& triangl
       dead[tris[l]] = 1;
       ++report.triangles_removed;
       for (Index w : triangles[tris[l]]) {
-        if (w != v && !queued[w]) {
-          queued[w] = 1;
+        if (w == v || queued[w]) continue;
+        queued[w] = 1;
+        if (finished.empty() || finished[w] == 1) {
           work.push_back(w);
+        } else if (finished[w] == 0) {
+          deferred.push_back(w);  // stays queued: deferred once
+        } else {
+          ++report.vertices_unjudged;
         }
       }
     }
   }
 
+  return report;
+}
+
+NonManifoldReport remove_non_manifold_vertices_at(std::vector<Triangle>& triangles,
+                                                  std::size_t vertex_count,
+                                                  std::span<const Index> suspects) {
+  std::vector<std::uint8_t> dead;
+  std::vector<Index> deferred;
+  const NonManifoldReport report =
+      mark_non_manifold_fans(triangles, vertex_count, suspects, {}, dead, deferred);
   std::size_t out = 0;
-  for (std::size_t t = 0; t < nt; ++t) {
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
     if (!dead[t]) triangles[out++] = triangles[t];
   }
   triangles.resize(out);

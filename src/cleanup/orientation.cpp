@@ -29,15 +29,6 @@ std::vector<std::array<Index, 2>> open_edges(const std::vector<Triangle>& triang
 
 namespace {
 
-// A well-mixed 64-bit key of an undirected edge (splitmix64's finaliser).
-std::uint64_t edge_key(Index u, Index v) {
-  std::uint64_t x = u < v ? std::uint64_t{u} << 32 | v : std::uint64_t{v} << 32 | u;
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
-}
-
 // open: the open edges when the caller has them (reversed with their component); null: a
 // component is open when the XOR of its triangles' edge keys is not zero. With no
 // non-manifold edge every inner edge is counted twice and cancels, so what is left is the XOR
@@ -121,6 +112,40 @@ std::uint64_t orient_components(std::vector<Triangle>& triangles,
 std::uint64_t orient_components(std::vector<Triangle>& triangles, std::span<const Vec3f> positions,
                                 std::vector<std::array<Index, 2>>& open) {
   return orient(triangles, positions, &open);
+}
+
+std::vector<std::uint8_t> group_flips(ParityUnionFind& groups, std::span<const GroupSums> sums,
+                                      bool orient, std::uint64_t& flipped) {
+  const std::size_t n = groups.size();
+  // The component's sums (at its root group) with each group's sums as its parity turns them.
+  std::vector<GroupSums> component(n);
+  std::vector<std::uint8_t> parity(n);
+  for (std::uint32_t g = 0; g < n; ++g) {
+    const auto [root, p] = groups.find(g);
+    parity[g] = p;
+    const GroupSums& s = sums[g];
+    GroupSums& c = component[root];
+    const double sign = p ? -1.0 : 1.0;
+    c.det += sign * s.det;
+    c.normal = c.normal + s.normal * sign;
+    c.centroid = c.centroid + s.centroid;
+    c.corners += s.corners;
+    c.edge_keys ^= s.edge_keys;
+  }
+  std::vector<std::uint8_t> reverse(n, 0);  // per root
+  flipped = 0;
+  for (std::uint32_t g = 0; g < n && orient; ++g) {
+    const GroupSums& c = component[g];
+    if (c.corners == 0) continue;  // not a root, or no triangle left
+    const Vec3 centre = c.centroid * (1.0 / c.corners);
+    const double volume = c.det - dot(centre, c.normal);
+    const bool vertical = c.edge_keys != 0 && std::abs(c.normal.z) > 0.5 * norm(c.normal);
+    reverse[g] = vertical ? c.normal.z < 0 : volume < 0;
+    flipped += reverse[g];
+  }
+  std::vector<std::uint8_t> flip(n);
+  for (std::uint32_t g = 0; g < n; ++g) flip[g] = parity[g] ^ reverse[groups.find(g).first];
+  return flip;
 }
 
 }  // namespace g2s

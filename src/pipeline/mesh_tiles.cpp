@@ -9,23 +9,52 @@
 #include "g2s/pipeline.hpp"
 
 namespace g2s {
+namespace {
 
-PipelineMesh mesh_tiles(const TileSource& source, const PipelineOptions& options) {
+// The mesh collected in memory, in global ids.
+class MemorySink final : public MeshSink {
+ public:
+  explicit MemorySink(std::uint64_t points) { mesh.xyz.assign(3 * points, 0.0); }
+  void vertex(Index id, const double xyz[3]) override {
+    ids_.push_back(id);
+    std::copy_n(xyz, 3, &mesh.xyz[3 * std::size_t{id}]);
+  }
+  void triangle(const Triangle& corners, const std::array<const double*, 3>&,
+                std::uint32_t group) override {
+    mesh.triangles.push_back({ids_[corners[0]], ids_[corners[1]], ids_[corners[2]]});
+    group_.push_back(group);
+  }
+  void finish(std::span<const std::uint8_t> flip) override {
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+      if (flip[group_[t]]) std::swap(mesh.triangles[t][1], mesh.triangles[t][2]);
+    }
+  }
+  PipelineMesh mesh;
+
+ private:
+  std::vector<Index> ids_;  // by vertex number
+  std::vector<std::uint32_t> group_;
+};
+
+}  // namespace
+
+PipelineSummary mesh_tiles(const TileSource& source, const PipelineOptions& options,
+                           MeshSink& sink) {
   std::unique_ptr<tbb::global_control> limit;
   if (options.threads > 0) {
     limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                   static_cast<std::size_t>(options.threads));
   }
   // Tiles grow in parallel while the stitcher, one tile at a time in index order, closes the
-  // seams of those already grown; a few tiles are in flight at once.
+  // seams of those already grown; tiles_in_flight bounds the tiles grown and waiting.
   const std::size_t tiles = source.tiles().size();
   const std::size_t workers =
       options.threads > 0 ? static_cast<std::size_t>(options.threads)
                           : static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
-  Stitcher stitcher(source, options);
+  Stitcher stitcher(source, options, sink);
   std::size_t next = 0;
   tbb::parallel_pipeline(
-      2 * workers + 1,
+      options.tiles_in_flight > 0 ? options.tiles_in_flight : 2 * workers,
       tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
                                           [&](tbb::flow_control& control) -> std::size_t {
                                             if (next == tiles) control.stop();
@@ -42,6 +71,12 @@ PipelineMesh mesh_tiles(const TileSource& source, const PipelineOptions& options
                 if (options.progress) options.progress(grown.first + 1, tiles);
               }));
   return stitcher.finish();
+}
+
+PipelineMesh mesh_tiles(const TileSource& source, const PipelineOptions& options) {
+  MemorySink sink(source.point_count());
+  static_cast<PipelineSummary&>(sink.mesh) = mesh_tiles(source, options, sink);
+  return std::move(sink.mesh);
 }
 
 }  // namespace g2s

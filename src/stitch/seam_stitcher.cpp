@@ -1,26 +1,31 @@
 // Stage 2 of the tiled pipeline: the seam stitcher (ALGORITHM.md §7.3). Tiles keep only the
 // triangles with every corner inside them, so a strip of triangles across each seam is missing.
 // Tiles are visited in index order; at tile i the seams with its already visited neighbours are
-// closed by growing G2S over the points within the band width of those seams, with every
-// triangle kept so far that touches those points loaded into the Point-Edge Map: their open
-// edges are the front, and no new triangle can give an edge a third triangle or a vertex a
-// crossing fan the clean-up cannot see. Points farther out are loaded as context, so the Gabriel
-// test sees the whole neighbourhood, but are not used.
+// closed by growing G2S over the points within the band width of those seams, with every live
+// triangle that touches those points loaded into the Point-Edge Map: their open edges are the
+// front, and no new triangle can give an edge a third triangle or a vertex a crossing fan the
+// clean-up cannot see. Points farther out are loaded as context, so the Gabriel test sees the
+// whole neighbourhood, but are not used.
 //
-// Orientation: every kept triangle belongs to an orientation group (from its tile or seam); the
+// Memory: only the live mesh is kept (stitch/live_mesh.hpp). After each tile the points no later
+// seam can reach are finished and the triangles around them released to the sink
+// (cleanup/release.cpp), so what stays is the band along the seams still open.
+//
+// Orientation: every triangle belongs to an orientation group (from its tile or seam); the
 // stitcher joins groups with a parity as it connects them, and the end flips each group so that
-// all of a component faces one way, then orients the component as the in-memory mesher does.
+// all of a component faces one way, and the component outward as the in-memory mesher does.
 #include <algorithm>
 #include <chrono>
 #include <numeric>
 
-#include "cleanup/cleanup.hpp"
-#include "common/union_find.hpp"
+#include "cleanup/release.hpp"
+#include "common/id_map.hpp"
 #include "g2s/error.hpp"
 #include "g2s/pipeline.hpp"
 #include "grid/hash_grid.hpp"
 #include "grow/grower.hpp"
 #include "pipeline/tile_geometry.hpp"
+#include "stitch/live_mesh.hpp"
 
 namespace g2s {
 namespace {
@@ -29,106 +34,101 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// Everything kept so far, in global ids, with each triangle's orientation group. Triangles are
-// kept step by step (step i: tile i's own, then its seams), each step recording the tiles its
-// triangles' corners lie in, so a seam looks only at the steps that reached its tiles.
-struct KeptMesh {
-  std::vector<Triangle> triangles;
-  std::vector<std::uint32_t> group;
-  ParityUnionFind groups;
-  std::vector<Index> second_fans;
-  std::vector<std::uint32_t> tile_of;                // by global id, for the tiles added so far
-  std::vector<std::size_t> step_begin;               // per step: its first triangle
-  std::vector<std::vector<std::size_t>> step_tiles;  // per step: its triangles' tiles, sorted
-
-  void add(const Triangle& t, std::uint32_t g) {
-    triangles.push_back(t);
-    group.push_back(g);
-  }
+// Seam widths at a tile, in the largest spacing around it (local_spacing): the band grown, the
+// context loaded around it, and how far from the tile's box a triangle made at its seam can
+// reach (a band point, or a corner of a live triangle touching one: a triangle's edges stay
+// within two search balls of max_radius spacings).
+struct SeamReach {
+  double band = 0;
+  double context = 0;
+  double touch = 0;
+  double margin = 0;  // the release margin beyond `touch`: the longest edge
 };
+
+SeamReach seam_reach(std::span<const TileInfo> tiles, std::size_t tile,
+                     const PipelineOptions& options) {
+  const double first = 2 * options.band_spacings * tiles[tile].spacing;
+  const double spacing = local_spacing(tiles, tile, tiles_near(tiles, tile, first));
+  SeamReach r;
+  r.band = options.band_spacings * spacing;
+  r.context = 2 * r.band;
+  r.margin = 2 * options.mesh.max_radius * spacing;
+  r.touch = std::max(r.context, r.band + r.margin);
+  return r;
+}
 
 class SeamStitcher {
  public:
-  SeamStitcher(const TileSource& source, const PipelineOptions& options, std::size_t ids)
-      : source_(source), options_(options), in_band_(ids, 0), loaded_(ids, 0) {}
+  SeamStitcher(const TileSource& source, const PipelineOptions& options)
+      : source_(source), options_(options) {}
 
-  // Closes the seams between `tile` and its neighbours with smaller indices. xyz: positions by
-  // global id, filled for the tiles up to `tile`.
-  std::uint64_t stitch(std::size_t tile, const std::vector<double>& xyz, KeptMesh& kept) {
+  // Closes the seams between `tile` and its neighbours with smaller indices, adding the new
+  // triangles to `live`. Returns how many were added and how many were left out because a
+  // corner was already finished.
+  std::pair<std::uint64_t, std::uint64_t> stitch(std::size_t tile, const SeamReach& reach,
+                                                 LiveMesh& live) {
     const std::span<const TileInfo> tiles = source_.tiles();
     const TileBox& box = tiles[tile].box;
-    const double reach0 = 2 * options_.band_spacings * tiles[tile].spacing;
-    const std::vector<std::size_t> near0 = tiles_near(tiles, tile, reach0);
-    const double spacing = local_spacing(tiles, tile, near0);
-    const double band = options_.band_spacings * spacing;
-    const double reach = 2 * band;  // the band and the context around it
-    const std::vector<std::size_t> near = tiles_near(tiles, tile, reach);
+    const double band = reach.band;
+    const std::vector<std::size_t> near = tiles_near(tiles, tile, reach.context);
     std::vector<std::size_t> earlier;
     for (std::size_t j : near) {
       if (j < tile) earlier.push_back(j);
     }
-    std::vector<std::size_t>& touched = kept.step_tiles[tile];
-    touched = earlier;  // tiles_near lists them in index order, all below `tile`
-    touched.push_back(tile);
-    if (earlier.empty()) return 0;
+    if (earlier.empty()) return {0, 0};
 
     // The band (growable) and its context, from the tile and its neighbours' borders.
     ids_.clear();
     local_.clear();
+    growable_.clear();
+    local_of_.clear();
     // Positions in a float frame at the tile's centre (offsets computed in double).
-    auto take = [&](Index id, bool growable, const double* p) {
-      if (loaded_[id]) return;
-      loaded_[id] = 1;
-      in_band_[id] = growable;
+    auto take = [&](Index id, bool in_band, const double* p) {
+      if (local_of_.insert(id, static_cast<std::uint32_t>(ids_.size())) != ids_.size()) return;
+      // A band point is live (within the tile's reach, so not finished): flag it for the preload.
+      const std::uint32_t s = in_band ? live.slot(id) : IdMap::kMissing;
+      if (s != IdMap::kMissing) live.flags[s] |= LiveMesh::kInBand;
       ids_.push_back(id);
+      growable_.push_back(s != IdMap::kMissing);
       for (int a = 0; a < 3; ++a) {
         local_.push_back(static_cast<float>(p[a] - 0.5 * (box.lo[a] + box.hi[a])));
       }
     };
     {
-      const TilePoints own = source_.load_border(tile, reach);
+      const TilePoints own = source_.load_border(tile, reach.context);
       for (std::size_t k = 0; k < own.size(); ++k) {
-        double d = reach + 1;
+        double d = reach.context + 1;
         for (std::size_t j : earlier) d = std::min(d, box_distance(tiles[j].box, &own.xyz[3 * k]));
-        if (d <= reach) take(own.ids[k], d <= band, &own.xyz[3 * k]);
+        if (d <= reach.context) take(own.ids[k], d <= band, &own.xyz[3 * k]);
       }
     }
     for (std::size_t j : near) {
-      const TilePoints border = source_.load_border(j, reach);
+      const TilePoints border = source_.load_border(j, reach.context);
       for (std::size_t k = 0; k < border.size(); ++k) {
         const double d = box_distance(box, &border.xyz[3 * k]);
-        if (d <= reach) take(border.ids[k], j < tile && d <= band, &border.xyz[3 * k]);
+        if (d <= reach.context) take(border.ids[k], j < tile && d <= band, &border.xyz[3 * k]);
       }
     }
-    // Every kept triangle touching the band, presented facing as its group currently does, so
-    // the grower starts from what earlier seams already decided. Its corners are in tiles up to
-    // this one, whose positions `xyz` already holds.
+    // Every live triangle touching the band, presented facing as its group currently does, so
+    // the grower starts from what earlier seams already decided; in the order they were made.
     preload_.clear();
     preload_group_.clear();
-    // Band points lie in this tile and its earlier neighbours: only the steps that touched one
-    // of those tiles kept triangles that can touch the band. Taken in the order they were kept.
-    const std::size_t end = kept.triangles.size();
-    for (std::size_t step = 0; step <= tile; ++step) {
-      const std::vector<std::size_t>& other = kept.step_tiles[step];
-      bool shared = false;
-      for (std::size_t a = 0, b = 0; a < other.size() && b < touched.size() && !shared;) {
-        shared = other[a] == touched[b];
-        if (other[a] < touched[b]) {
-          ++a;
-        } else {
-          ++b;
-        }
+    for (std::size_t t = 0; t < live.triangles.size(); ++t) {
+      const Triangle& tri = live.triangles[t];
+      if (!((live.flags[tri[0]] | live.flags[tri[1]] | live.flags[tri[2]]) & LiveMesh::kInBand)) {
+        continue;
       }
-      if (!shared) continue;
-      const std::size_t last = step < tile ? kept.step_begin[step + 1] : end;
-      for (std::size_t t = kept.step_begin[step]; t < last; ++t) {
-        const Triangle& tri = kept.triangles[t];
-        if (!in_band_[tri[0]] && !in_band_[tri[1]] && !in_band_[tri[2]]) continue;
-        const auto [root, parity] = kept.groups.find(kept.group[t]);
-        preload_.push_back(parity ? Triangle{tri[0], tri[2], tri[1]} : tri);
-        preload_group_.push_back(root);
-        for (Index v : tri) take(v, in_band_[v], &xyz[3 * std::size_t{v}]);
+      const auto [root, parity] = live.groups.find(live.group[t]);
+      Triangle ids{live.id[tri[0]], live.id[tri[1]], live.id[tri[2]]};
+      if (parity) std::swap(ids[1], ids[2]);
+      preload_.push_back(ids);
+      preload_group_.push_back(root);
+      for (Index s : tri) {
+        take(live.id[s], (live.flags[s] & LiveMesh::kInBand) != 0, &live.xyz[3 * std::size_t{s}]);
       }
+    }
+    for (std::size_t k = 0; k < ids_.size(); ++k) {
+      if (growable_[k]) live.flags[live.slot(ids_[k])] &= ~LiveMesh::kInBand;
     }
 
     const HashGrid grid(local_, ids_);
@@ -148,16 +148,17 @@ class SeamStitcher {
       for (Index& v : t) v = grid_index(v);
     }
     std::vector<std::uint8_t> growable(grid.size());
-    for (std::uint32_t k = 0; k < grid.size(); ++k) growable[k] = in_band_[grid.id(k)];
+    for (std::uint32_t k = 0; k < grid.size(); ++k) {
+      growable[k] = growable_[local_of_.find(grid.id(k))];
+    }
 
     MeshOptions mesh_options = options_.mesh;
     mesh_options.progress = {};
     GrowResult grown = grow_mesh(grid, mesh_options,
                                  {preload_, preload_group_, growable, options_.stitch_retries});
 
-    // Orientation: per grower group, the first preloaded triangle anchors it to a kept group.
+    // Orientation: per grower group, the first preloaded triangle anchors it to a live group.
     const std::size_t preloaded = preload_.size();
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> anchor;  // grower group -> preload k
     std::vector<std::uint32_t> group_ids(grown.group.begin(), grown.group.end());
     std::sort(group_ids.begin(), group_ids.end());
     group_ids.erase(std::unique(group_ids.begin(), group_ids.end()), group_ids.end());
@@ -172,11 +173,24 @@ class SeamStitcher {
         a = k;
         continue;
       }
-      kept.groups.unite(preload_group_[a], preload_group_[k],
+      live.groups.unite(preload_group_[a], preload_group_[k],
                         static_cast<std::uint8_t>(grown.flip[k] ^ grown.flip[a]));
     }
     std::vector<std::uint32_t> fresh(group_ids.size(), kNoIndex);  // groups with no anchor
+    std::uint64_t added = 0, dropped = 0;
     for (std::size_t k = 0; k < grown.triangles.size(); ++k) {
+      Triangle t = grown.triangles[k];
+      Triangle slots{};
+      bool finished = false;
+      for (int c = 0; c < 3; ++c) {
+        slots[c] = live.slot(grid.id(t[c]));
+        finished = finished || slots[c] == IdMap::kMissing ||
+                   (live.flags[slots[c]] & LiveMesh::kFinished) != 0;
+      }
+      if (finished) {
+        ++dropped;
+        continue;
+      }
       const std::size_t s = slot(grown.group[preloaded + k]);
       std::uint8_t flip = grown.flip[preloaded + k];
       std::uint32_t group = 0;
@@ -184,30 +198,27 @@ class SeamStitcher {
         flip ^= grown.flip[anchor_of[s]];
         group = preload_group_[anchor_of[s]];
       } else {
-        if (fresh[s] == kNoIndex) fresh[s] = kept.groups.add();
+        if (fresh[s] == kNoIndex) fresh[s] = live.add_group();
         group = fresh[s];
       }
-      Triangle t = grown.triangles[k];
-      if (flip) std::swap(t[1], t[2]);
-      kept.add({grid.id(t[0]), grid.id(t[1]), grid.id(t[2])}, group);
-      // A corner taken from a preloaded triangle can lie in a tile beyond this seam's.
-      for (Index v : kept.triangles.back()) touched.push_back(kept.tile_of[v]);
+      if (flip) std::swap(slots[1], slots[2]);
+      live.add_triangle(slots, group);
+      ++added;
     }
-    std::sort(touched.begin(), touched.end());
-    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
-    for (Index v : grown.second_fans) kept.second_fans.push_back(grid.id(v));
-
-    for (Index id : ids_) loaded_[id] = in_band_[id] = 0;
-    return grown.triangles.size();
+    for (Index v : grown.second_fans) {
+      const std::uint32_t s = live.slot(grid.id(v));
+      if (s != IdMap::kMissing) live.flags[s] |= LiveMesh::kSuspect;
+    }
+    return {added, dropped};
   }
 
  private:
   const TileSource& source_;
   const PipelineOptions& options_;
-  std::vector<std::uint8_t> in_band_;  // by global id, for the points of the current seam
-  std::vector<std::uint8_t> loaded_;
+  IdMap local_of_;  // global id -> index in ids_, for the points of the current seam
   std::vector<Index> ids_;
   std::vector<float> local_;
+  std::vector<std::uint8_t> growable_;
   std::vector<Triangle> preload_;
   std::vector<std::uint32_t> preload_group_;
 };
@@ -215,27 +226,53 @@ class SeamStitcher {
 }  // namespace
 
 struct Stitcher::Impl {
-  Impl(const TileSource& s, const PipelineOptions& o)
-      : source(s), options(o), n(s.point_count()), stitcher(s, o, n) {}
+  Impl(const TileSource& s, const PipelineOptions& o, MeshSink& k)
+      : source(s), options(o), sink(k), stitcher(s, o), live(s.tiles().size()) {}
   const TileSource& source;
   const PipelineOptions& options;
-  const std::uint64_t n;
+  MeshSink& sink;
   SeamStitcher stitcher;
-  KeptMesh kept;
-  PipelineMesh out;
+  LiveMesh live;
+  std::vector<SeamReach> reach;  // per tile
+  Vec3 origin{0, 0, 0};
+  ReleaseCounts released;
+  PipelineSummary out;
   std::size_t next = 0;  // the tile add() expects
+
+  // The last step whose seam can touch a point of `tile` at p: the largest later tile within
+  // its reach; with `margin`, within its reach and its margin (the release step).
+  // `later`: the candidates, increasing; `inside`: the largest reach and margin among them.
+  std::uint32_t last_step(std::size_t tile, const double* p, std::span<const std::size_t> later,
+                          double inside, bool margin) const {
+    const std::span<const TileInfo> tiles = source.tiles();
+    const TileBox& box = tiles[tile].box;
+    // Every other box lies outside this one: a point deeper inside than any reach is done.
+    double depth = inside + 1;
+    for (int a = 0; a < 3; ++a) depth = std::min({depth, p[a] - box.lo[a], box.hi[a] - p[a]});
+    if (depth > inside) return static_cast<std::uint32_t>(tile);
+    for (std::size_t k = later.size(); k-- > 0;) {
+      const SeamReach& r = reach[later[k]];
+      if (box_distance(tiles[later[k]].box, p) <= r.touch + (margin ? r.margin : 0.0)) {
+        return static_cast<std::uint32_t>(later[k]);
+      }
+    }
+    return static_cast<std::uint32_t>(tile);
+  }
 };
 
-Stitcher::Stitcher(const TileSource& source, const PipelineOptions& options) {
-  if (source.point_count() > kNoIndex) {
-    throw Error(Exit::bad_input, "cloud has more than 4,294,967,295 points");
+Stitcher::Stitcher(const TileSource& source, const PipelineOptions& options, MeshSink& sink) {
+  if (source.point_count() >= kNoIndex) {
+    throw Error(Exit::bad_input, "cloud has more than 4,294,967,294 points");
   }
-  impl_ = std::make_unique<Impl>(source, options);
-  impl_->out.tiles = source.tiles().size();
-  impl_->out.xyz.assign(3 * impl_->n, 0.0);
-  impl_->kept.tile_of.assign(impl_->n, 0);
-  impl_->kept.step_begin.assign(source.tiles().size(), 0);
-  impl_->kept.step_tiles.resize(source.tiles().size());
+  impl_ = std::make_unique<Impl>(source, options, sink);
+  const std::span<const TileInfo> tiles = source.tiles();
+  impl_->out.tiles = tiles.size();
+  for (std::size_t t = 0; t < tiles.size(); ++t) {
+    impl_->reach.push_back(seam_reach(tiles, t, options));
+  }
+  const TileBox bounds = tiles_bounds(tiles);
+  impl_->origin = {0.5 * (bounds.lo[0] + bounds.hi[0]), 0.5 * (bounds.lo[1] + bounds.hi[1]),
+                   0.5 * (bounds.lo[2] + bounds.hi[2])};
 }
 
 Stitcher::~Stitcher() = default;
@@ -245,77 +282,84 @@ void Stitcher::add(std::size_t tile, TileGrowth growth) {
   if (tile != m.next) throw Error(Exit::failure, "stitch: tiles must come in index order");
   ++m.next;
   const auto start = std::chrono::steady_clock::now();
-  const TilePoints points =
-      growth.points.size() == growth.report.points ? std::move(growth.points) : m.source.load(tile);
-  for (std::size_t k = 0; k < points.size(); ++k) {
-    if (points.ids[k] >= m.n)
-      throw Error(Exit::bad_input, "tile store: a point id is out of range");
-    std::copy_n(&points.xyz[3 * k], 3, &m.out.xyz[3 * std::size_t{points.ids[k]}]);
-    m.kept.tile_of[points.ids[k]] = static_cast<std::uint32_t>(tile);
+  const std::span<const TileInfo> tiles = m.source.tiles();
+  LiveMesh& live = m.live;
+  {
+    const TilePoints points = growth.points.size() == growth.report.points
+                                  ? std::move(growth.points)
+                                  : m.source.load(tile);
+    std::vector<std::size_t> later;
+    double inside = 0;
+    for (std::size_t j = tile + 1; j < tiles.size(); ++j) {
+      const double far = m.reach[j].touch + m.reach[j].margin;
+      if (tiles[j].points > 0 && box_gap(tiles[tile].box, tiles[j].box) <= far) {
+        later.push_back(j);
+        inside = std::max(inside, far);
+      }
+    }
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      if (points.ids[k] >= m.source.point_count()) {
+        throw Error(Exit::bad_input, "tile store: a point id is out of range");
+      }
+      const double* p = &points.xyz[3 * k];
+      const std::uint32_t release = m.last_step(tile, p, later, inside, true);
+      const std::uint32_t finish =
+          release == tile ? release : m.last_step(tile, p, later, inside, false);
+      live.add_point(points.ids[k], p, finish, release);
+    }
   }
-  m.kept.step_begin[tile] = m.kept.triangles.size();
-  const auto base = static_cast<std::uint32_t>(m.kept.groups.size());
-  for (std::uint32_t k = 0; k < growth.groups; ++k) m.kept.groups.add();
+  const auto base = static_cast<std::uint32_t>(live.groups.size());
+  for (std::uint32_t k = 0; k < growth.groups; ++k) live.add_group();
   for (std::size_t k = 0; k < growth.triangles.size(); ++k) {
-    m.kept.add(growth.triangles[k], base + growth.group[k]);
+    Triangle slots{};
+    for (int c = 0; c < 3; ++c) {
+      slots[c] = live.slot(growth.triangles[k][c]);
+      if (slots[c] == IdMap::kMissing) {
+        throw Error(Exit::bad_input, "grown tile: a triangle corner is not a point of its tile");
+      }
+    }
+    live.add_triangle(slots, base + growth.group[k]);
   }
-  m.kept.second_fans.insert(m.kept.second_fans.end(), growth.second_fans.begin(),
-                            growth.second_fans.end());
+  for (Index v : growth.second_fans) {
+    const std::uint32_t s = live.slot(v);
+    if (s != IdMap::kMissing) live.flags[s] |= LiveMesh::kSuspect;
+  }
   MeshReport& r = m.out.report;
   r.points += growth.report.points;
   r.seeds += growth.report.seeds;
   r.duplicates_merged += growth.report.duplicates_merged;
   r.seconds_grid += growth.report.seconds_grid;
   r.seconds_grow += growth.report.seconds_grow;
+  r.triangles_grown += growth.triangles.size();
   r.spacing = std::max(r.spacing, growth.report.spacing);
   growth = TileGrowth{};
-  m.out.triangles_stitched += m.stitcher.stitch(tile, m.out.xyz, m.kept);
+  const auto [added, dropped] = m.stitcher.stitch(tile, m.reach[tile], live);
+  m.out.triangles_stitched += added;
+  m.out.seam_triangles_dropped += dropped;
+  r.triangles_grown += added;
+  const auto release_start = std::chrono::steady_clock::now();
+  release_finished(live, tile, m.origin, m.sink, m.released);
+  r.seconds_cleanup += seconds_since(release_start);
   m.out.seconds_stitch += seconds_since(start);
 }
 
-PipelineMesh Stitcher::finish() {
+PipelineSummary Stitcher::finish() {
   Impl& m = *impl_;
   if (m.next != m.source.tiles().size()) throw Error(Exit::failure, "stitch: a tile is missing");
-  const std::span<const TileInfo> tiles = m.source.tiles();
-  PipelineMesh& out = m.out;
-  KeptMesh& kept = m.kept;
-  const auto cleanup_start = std::chrono::steady_clock::now();
-  for (std::size_t t = 0; t < kept.triangles.size(); ++t) {
-    if (kept.groups.find(kept.group[t]).second) {
-      std::swap(kept.triangles[t][1], kept.triangles[t][2]);
-    }
+  if (!m.live.triangles.empty()) {
+    throw Error(Exit::failure, "stitch: triangles left unfinished after the last tile");
   }
-  out.report.triangles_grown = kept.triangles.size();
-  const NonManifoldReport nm =
-      remove_non_manifold_vertices_at(kept.triangles, m.n, kept.second_fans);
-  out.report.triangles_removed = nm.triangles_removed;
-  out.report.non_manifold_vertices_fixed = nm.vertices_fixed;
-  if (m.options.mesh.orient) {
-    const TileBox bounds = tiles_bounds(tiles);
-    std::vector<Vec3f> positions(m.n);
-    for (std::size_t i = 0; i < m.n; ++i) {
-      positions[i] = {static_cast<float>(out.xyz[3 * i] - 0.5 * (bounds.lo[0] + bounds.hi[0])),
-                      static_cast<float>(out.xyz[3 * i + 1] - 0.5 * (bounds.lo[1] + bounds.hi[1])),
-                      static_cast<float>(out.xyz[3 * i + 2] - 0.5 * (bounds.lo[2] + bounds.hi[2]))};
-    }
-    out.report.components_flipped = orient_components(kept.triangles, positions);
-  }
-  out.triangles = std::move(kept.triangles);
-  out.report.seconds_cleanup = seconds_since(cleanup_start);
-  return std::move(out);
-}
-
-PipelineMesh stitch_tiles(const TileSource& source, std::vector<TileGrowth> growths,
-                          const PipelineOptions& options) {
-  if (growths.size() != source.tiles().size()) {
-    throw Error(Exit::failure, "stitch: one growth per tile");
-  }
-  Stitcher stitcher(source, options);
-  for (std::size_t t = 0; t < growths.size(); ++t) {
-    stitcher.add(t, std::move(growths[t]));
-    if (options.progress) options.progress(t + 1, growths.size());
-  }
-  return stitcher.finish();
+  PipelineSummary& out = m.out;
+  out.triangles = m.released.triangles;
+  out.vertices = m.released.vertices;
+  out.peak_live_points = m.live.peak_points;
+  out.report.triangles_removed = m.released.non_manifold.triangles_removed;
+  out.report.non_manifold_vertices_fixed = m.released.non_manifold.vertices_fixed;
+  out.vertices_unjudged = m.released.non_manifold.vertices_unjudged;
+  const std::vector<std::uint8_t> flip =
+      group_flips(m.live.groups, m.live.sums, m.options.mesh.orient, out.report.components_flipped);
+  m.sink.finish(flip);
+  return out;
 }
 
 }  // namespace g2s

@@ -1,0 +1,93 @@
+// Finishing points and releasing triangles as the stitcher sweeps the tiles. A point is finished
+// after the last step that can touch it (LiveMesh), so its star is complete: its fans can be
+// judged exactly as the in-memory pass would. A triangle with three released corners can change
+// no more except for the orientation of its group, decided at the very end.
+#include "cleanup/release.hpp"
+
+namespace g2s {
+namespace {
+
+void add_to_sums(GroupSums& s, const std::array<const double*, 3>& xyz, const Vec3& origin,
+                 const Triangle& ids) {
+  auto at = [&](int k) { return Vec3{xyz[k][0], xyz[k][1], xyz[k][2]} - origin; };
+  const Vec3 pa = at(0), pb = at(1), pc = at(2);
+  s.det += dot(pa, cross(pb, pc));
+  s.normal = s.normal + cross(pb - pa, pc - pa);
+  s.centroid = s.centroid + pa + pb + pc;
+  s.corners += 3;
+  s.edge_keys ^= edge_key(ids[0], ids[1]) ^ edge_key(ids[1], ids[2]) ^ edge_key(ids[2], ids[0]);
+}
+
+}  // namespace
+
+void release_finished(LiveMesh& live, std::size_t step, const Vec3& origin, MeshSink& sink,
+                      ReleaseCounts& counts) {
+  std::vector<Index> suspects;
+  for (std::uint32_t s : live.finishing[step]) {
+    live.flags[s] |= LiveMesh::kFinished;
+    if (live.flags[s] & LiveMesh::kSuspect) suspects.push_back(s);
+  }
+  live.finishing[step] = {};
+  // Slots that may be free once this step's triangles are gone.
+  std::vector<std::uint32_t> maybe_free = std::move(live.releasing[step]);
+  live.releasing[step] = {};
+  for (std::uint32_t s : maybe_free) live.flags[s] |= LiveMesh::kReleased;
+  std::vector<std::uint8_t> dead;
+  if (!suspects.empty()) {
+    // Finished points with a triangle already handed on cannot be judged again (their star is
+    // no longer whole): the release margin makes that rare, and it is counted.
+    std::vector<std::uint8_t> finished(live.capacity());
+    for (std::size_t s = 0; s < finished.size(); ++s) {
+      if (live.flags[s] & LiveMesh::kFinished) finished[s] = live.number[s] == kNoIndex ? 1 : 2;
+    }
+    std::vector<Index> deferred;
+    const NonManifoldReport nm =
+        mark_non_manifold_fans(live.triangles, live.capacity(), suspects, finished, dead, deferred);
+    counts.non_manifold.vertices_fixed += nm.vertices_fixed;
+    counts.non_manifold.triangles_removed += nm.triangles_removed;
+    counts.non_manifold.vertices_unjudged += nm.vertices_unjudged;
+    for (Index s : deferred) live.flags[s] |= LiveMesh::kSuspect;
+  }
+  std::size_t kept = 0;
+  for (std::size_t t = 0; t < live.triangles.size(); ++t) {
+    const Triangle tri = live.triangles[t];
+    const bool removed = !dead.empty() && dead[t];
+    const bool released =
+        (live.flags[tri[0]] & live.flags[tri[1]] & live.flags[tri[2]] & LiveMesh::kReleased) != 0;
+    if (!removed && !released) {
+      live.triangles[kept] = tri;
+      live.group[kept] = live.group[t];
+      ++kept;
+      continue;
+    }
+    if (!removed) {
+      Triangle numbers{};
+      for (int k = 0; k < 3; ++k) {
+        const Index s = tri[k];
+        if (live.number[s] == kNoIndex) {
+          live.number[s] = counts.vertices++;
+          sink.vertex(live.id[s], &live.xyz[3 * std::size_t{s}]);
+        }
+        numbers[k] = live.number[s];
+      }
+      const std::array<const double*, 3> xyz{&live.xyz[3 * std::size_t{tri[0]}],
+                                             &live.xyz[3 * std::size_t{tri[1]}],
+                                             &live.xyz[3 * std::size_t{tri[2]}]};
+      sink.triangle(numbers, xyz, live.group[t]);
+      ++counts.triangles;
+      add_to_sums(live.sums[live.group[t]], xyz, origin,
+                  {live.id[tri[0]], live.id[tri[1]], live.id[tri[2]]});
+    }
+    for (Index s : tri) {
+      --live.uses[s];
+      maybe_free.push_back(s);
+    }
+  }
+  live.triangles.resize(kept);
+  live.group.resize(kept);
+  for (std::uint32_t s : maybe_free) {
+    if ((live.flags[s] & LiveMesh::kReleased) && live.uses[s] == 0) live.free_slot(s);
+  }
+}
+
+}  // namespace g2s

@@ -1,0 +1,213 @@
+// MeshStreamWriter: the tiled pipeline's output stage. Triangles arrive as the stitcher finishes
+// them but their orientation is known only at the end, so they go first to a spill file beside
+// the target (a temporary, removed however the run ends), then one sequential pass writes the
+// real file with each group's flip applied. Memory stays a pair of buffers whatever the mesh.
+#include <fcntl.h>
+#include <fmt/core.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+
+#include "g2s/error.hpp"
+#include "g2s/io.hpp"
+#include "io/le_bytes.hpp"
+
+namespace g2s {
+namespace {
+
+constexpr std::size_t kBufferSize = 1u << 20;
+
+// An append-only temporary file read back once from the start.
+class SpillFile {
+ public:
+  SpillFile(const std::filesystem::path& target, const char* kind)
+      : target_(target),
+        path_(target.parent_path() /
+              fmt::format(".{}.{}-{}", target.filename().string(), kind, ::getpid())) {
+    fd_ = ::open(path_.path().c_str(), O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+    if (fd_ < 0) fail("cannot create a spill file");
+    buffer_.reserve(kBufferSize);
+  }
+  ~SpillFile() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  SpillFile(const SpillFile&) = delete;
+  SpillFile& operator=(const SpillFile&) = delete;
+
+  void append(const void* data, std::size_t bytes) {
+    if (buffer_.size() + bytes > kBufferSize) flush();
+    const auto* p = static_cast<const char*>(data);
+    buffer_.insert(buffer_.end(), p, p + bytes);
+  }
+
+  // Calls each(record) for every `record_bytes` record appended, in order.
+  template <typename Each>
+  void read_back(std::size_t record_bytes, Each each) {
+    flush();
+    std::vector<char> chunk(kBufferSize / record_bytes * record_bytes);
+    for (std::uint64_t offset = 0; offset < size_;) {
+      const auto want =
+          static_cast<std::size_t>(std::min<std::uint64_t>(chunk.size(), size_ - offset));
+      std::size_t got = 0;
+      while (got < want) {
+        const ssize_t n =
+            ::pread(fd_, chunk.data() + got, want - got, static_cast<off_t>(offset + got));
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) fail("cannot read back the spill file");
+        got += static_cast<std::size_t>(n);
+      }
+      for (std::size_t k = 0; k < want; k += record_bytes) each(chunk.data() + k);
+      offset += want;
+    }
+  }
+
+ private:
+  void flush() {
+    std::size_t done = 0;
+    while (done < buffer_.size()) {
+      const ssize_t n = ::write(fd_, buffer_.data() + done, buffer_.size() - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) fail("cannot write the spill file");
+      done += static_cast<std::size_t>(n);
+    }
+    size_ += buffer_.size();
+    buffer_.clear();
+  }
+  [[noreturn]] void fail(const char* what) const {
+    throw Error(Exit::write_failed,
+                fmt::format("{}: {}: {}", target_.string(), what, std::strerror(errno)));
+  }
+
+  std::filesystem::path target_;
+  TemporaryPath path_;
+  int fd_ = -1;
+  std::vector<char> buffer_;
+  std::uint64_t size_ = 0;
+};
+
+bool survives_float(double v) {
+  return static_cast<double>(static_cast<float>(v)) == v;
+}
+
+}  // namespace
+
+struct MeshStreamWriter::Impl {
+  Impl(const std::filesystem::path& t, MeshFormat f)
+      : target(t), format(f), triangles(t, "triangles") {
+    if (format == MeshFormat::ply_binary) vertices = std::make_unique<SpillFile>(t, "vertices");
+  }
+  std::filesystem::path target;
+  MeshFormat format;
+  SpillFile triangles;                  // STL: group, 9 floats; PLY: group, 3 vertex numbers
+  std::unique_ptr<SpillFile> vertices;  // PLY: 3 doubles per vertex
+  std::uint64_t vertex_count = 0;
+  std::uint64_t triangle_count = 0;
+  bool as_float = true;
+  double largest = 0.0;
+  double worst = 0.0;
+};
+
+MeshStreamWriter::MeshStreamWriter(const std::filesystem::path& target, MeshFormat format)
+    : impl_(std::make_unique<Impl>(target, format)) {}
+
+MeshStreamWriter::~MeshStreamWriter() = default;
+
+void MeshStreamWriter::vertex(Index, const double xyz[3]) {
+  Impl& m = *impl_;
+  ++m.vertex_count;
+  for (int k = 0; k < 3; ++k) {
+    m.largest = std::max(m.largest, std::abs(xyz[k]));
+    m.worst = std::max(m.worst, std::abs(xyz[k] - static_cast<double>(static_cast<float>(xyz[k]))));
+    m.as_float = m.as_float && survives_float(xyz[k]);
+  }
+  if (m.vertices) m.vertices->append(xyz, 3 * sizeof(double));
+}
+
+void MeshStreamWriter::triangle(const Triangle& corners, const std::array<const double*, 3>& xyz,
+                                std::uint32_t group) {
+  Impl& m = *impl_;
+  ++m.triangle_count;
+  if (m.format == MeshFormat::ply_binary) {
+    const std::uint32_t record[4] = {group, corners[0], corners[1], corners[2]};
+    m.triangles.append(record, sizeof record);
+    return;
+  }
+  struct {
+    std::uint32_t group;
+    float xyz[9];
+  } record{group, {}};
+  for (int c = 0; c < 3; ++c) {
+    for (int k = 0; k < 3; ++k) record.xyz[3 * c + k] = static_cast<float>(xyz[c][k]);
+  }
+  m.triangles.append(&record, sizeof record);
+}
+
+void MeshStreamWriter::finish(std::span<const std::uint8_t> flip) {
+  Impl& m = *impl_;
+  if (m.triangle_count == 0) return;  // no file: the caller says why there is no surface
+  auto flipped = [&](std::uint32_t group) {
+    if (group >= flip.size()) throw Error(Exit::failure, "mesh writer: unknown orientation group");
+    return flip[group] != 0;
+  };
+  if (m.format != MeshFormat::ply_binary) {
+    StlWriter writer(m.target, m.format == MeshFormat::stl_ascii);
+    m.triangles.read_back(40, [&](const char* record) {
+      std::uint32_t group = 0;
+      float f[9];
+      std::memcpy(&group, record, 4);
+      std::memcpy(f, record + 4, sizeof f);
+      double c[9];
+      for (int k = 0; k < 9; ++k) c[k] = f[k];
+      if (flipped(group)) {
+        writer.add(c, c + 6, c + 3);
+      } else {
+        writer.add(c, c + 3, c + 6);
+      }
+    });
+    writer.finish();
+    return;
+  }
+  AtomicFile file(m.target);
+  const char* type = m.as_float ? "float" : "double";
+  const std::string header = fmt::format(
+      "ply\nformat binary_little_endian 1.0\ncomment written by g2s\nelement vertex {}\n"
+      "property {} x\nproperty {} y\nproperty {} z\nelement face {}\n"
+      "property list uchar uint vertex_indices\nend_header\n",
+      m.vertex_count, type, type, type, m.triangle_count);
+  file.write(header.data(), header.size());
+  char out[24];
+  m.vertices->read_back(3 * sizeof(double), [&](const char* record) {
+    char* p = out;
+    for (int k = 0; k < 3; ++k) {
+      double c = 0;
+      std::memcpy(&c, record + 8 * k, 8);
+      p = m.as_float ? io::put_le(p, static_cast<float>(c)) : io::put_le(p, c);
+    }
+    file.write(out, static_cast<std::size_t>(p - out));
+  });
+  m.triangles.read_back(16, [&](const char* record) {
+    std::uint32_t r[4];
+    std::memcpy(r, record, sizeof r);
+    if (flipped(r[0])) std::swap(r[2], r[3]);
+    char* p = io::put_le(out, std::uint8_t{3});
+    for (int k = 1; k < 4; ++k) p = io::put_le(p, r[k]);
+    file.write(out, static_cast<std::size_t>(p - out));
+  });
+  file.commit();
+}
+
+std::uint64_t MeshStreamWriter::triangles() const {
+  return impl_->triangle_count;
+}
+
+double MeshStreamWriter::largest_coordinate() const {
+  return impl_->largest;
+}
+
+double MeshStreamWriter::float_rounding() const {
+  return impl_->worst;
+}
+
+}  // namespace g2s

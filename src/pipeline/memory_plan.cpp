@@ -1,0 +1,57 @@
+// The memory budget of `g2s mesh`, turned into tile sizes. What grows with the tile size: each
+// thread growing a tile (its points, halo, hash grid, front and triangles), each tile grown and
+// waiting for the stitcher (its points and kept triangles), and the stitcher taking in a tile
+// (a live slot per point until the tile's interior is released). What does not: the band of
+// open seams, a few tens of spacings wide, small next to any tile. Bytes per point measured
+// with /usr/bin/time -v on the synthetic torus (docs/pipeline.md, "Memory").
+#include <fmt/core.h>
+#include <tbb/info.h>
+#include <unistd.h>
+
+#include <algorithm>
+
+#include "g2s/error.hpp"
+#include "g2s/pipeline.hpp"
+
+namespace g2s {
+namespace {
+
+constexpr double kGrowBytesPerPoint = 400;     // a tile being grown, with its halo
+constexpr double kWaitingBytesPerPoint = 100;  // a grown tile waiting to be stitched
+constexpr double kStitchBytesPerPoint = 150;   // the tile being stitched and released
+constexpr double kFixedBytes = 40e6;           // code, TBB, buffers, the live band
+constexpr double kStoreBytesPerPoint = 64;     // the tile store writer, per point of a round
+constexpr std::uint64_t kLargestTile = std::uint64_t{1} << 20;
+constexpr std::uint64_t kSmallestTile = 4096;
+
+}  // namespace
+
+MemoryPlan plan_memory(std::uint64_t budget_bytes, int threads) {
+  const auto workers = static_cast<std::size_t>(
+      threads > 0 ? threads : std::max(1, tbb::info::default_concurrency()));
+  MemoryPlan plan;
+  plan.tiles_in_flight = workers + 1;
+  const double usable = static_cast<double>(budget_bytes) - kFixedBytes;
+  const double per_tile_point = static_cast<double>(workers) * kGrowBytesPerPoint +
+                                kWaitingBytesPerPoint + kStitchBytesPerPoint;
+  const double tile = usable / per_tile_point;
+  if (!(tile >= static_cast<double>(kSmallestTile))) {
+    throw Error(Exit::usage,
+                fmt::format("--memory {} MB is too small for {} threads: at least {:.0f} MB",
+                            budget_bytes >> 20, workers,
+                            (kFixedBytes + per_tile_point * kSmallestTile) / 1048576.0 + 1));
+  }
+  plan.tile_points = std::min(kLargestTile, static_cast<std::uint64_t>(tile));
+  plan.round_points = std::clamp(static_cast<std::uint64_t>(usable / kStoreBytesPerPoint),
+                                 plan.tile_points, std::uint64_t{8} << 20);
+  return plan;
+}
+
+std::uint64_t default_memory_budget() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES);
+  const long page = ::sysconf(_SC_PAGESIZE);
+  if (pages <= 0 || page <= 0) return std::uint64_t{4} << 30;
+  return static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page) / 2;
+}
+
+}  // namespace g2s

@@ -1,0 +1,100 @@
+// What the stitcher holds between tiles: the points some tile still to come can touch, and the
+// triangles not yet handed on. Points live in slots (recycled, found by global id through an
+// IdMap), so memory follows the band of unfinished seams, not the size of the cloud.
+//
+// Every point gets two steps when its tile arrives. After the last tile whose seam can still give
+// it a triangle, it is finished: its star is complete and its fans are cleaned. Some steps later
+// (a margin farther from the tiles to come) it is released: a triangle whose corners are all
+// released leaves for the sink (src/cleanup/release.cpp). The margin keeps a finished point's
+// triangles live while the clean-up of points finishing next to it may still delete some of
+// them and so split its fan, which must then be judged again on its whole star.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "cleanup/cleanup.hpp"
+#include "common/id_map.hpp"
+#include "common/union_find.hpp"
+#include "g2s/error.hpp"
+#include "g2s/types.hpp"
+
+namespace g2s {
+
+struct LiveMesh {
+  static constexpr std::uint8_t kFinished = 1;
+  static constexpr std::uint8_t kSuspect = 2;  // may have more than one fan
+  static constexpr std::uint8_t kInBand = 4;   // scratch of the seam being stitched
+  static constexpr std::uint8_t kReleased = 8;
+
+  IdMap slot_of;  // global id -> slot
+  std::vector<Index> id;
+  std::vector<double> xyz;            // 3 per slot
+  std::vector<std::uint32_t> number;  // vertex number given to the sink; kNoIndex before
+  std::vector<std::uint32_t> uses;    // live triangles with this corner
+  std::vector<std::uint8_t> flags;
+  std::vector<std::uint32_t> free_slots;
+  std::vector<std::vector<std::uint32_t>> finishing;  // per step: the slots it finishes
+  std::vector<std::vector<std::uint32_t>> releasing;  // per step: the slots it releases
+
+  std::vector<Triangle> triangles;  // in slots
+  std::vector<std::uint32_t> group;
+  ParityUnionFind groups;
+  std::vector<GroupSums> sums;  // per group
+
+  std::size_t peak_points = 0;
+
+  explicit LiveMesh(std::size_t steps) : finishing(steps), releasing(steps) {}
+
+  std::size_t capacity() const { return id.size(); }
+
+  // A point of the tile being added, finished after step `finish` and released after `release`.
+  void add_point(Index point, const double* p, std::uint32_t finish, std::uint32_t release) {
+    std::uint32_t s = 0;
+    if (free_slots.empty()) {
+      s = static_cast<std::uint32_t>(id.size());
+      id.push_back(point);
+      xyz.insert(xyz.end(), p, p + 3);
+      number.push_back(kNoIndex);
+      uses.push_back(0);
+      flags.push_back(0);
+    } else {
+      s = free_slots.back();
+      free_slots.pop_back();
+      id[s] = point;
+      std::copy_n(p, 3, &xyz[3 * std::size_t{s}]);
+      number[s] = kNoIndex;
+      uses[s] = 0;
+      flags[s] = 0;
+    }
+    if (slot_of.insert(point, s) != s) {
+      throw Error(Exit::bad_input, "tile store: a point id appears in two tiles");
+    }
+    finishing[finish].push_back(s);
+    releasing[release].push_back(s);
+    peak_points = std::max(peak_points, slot_of.size());
+  }
+
+  // The slot of a live point, or IdMap::kMissing.
+  std::uint32_t slot(Index point) const { return slot_of.find(point); }
+
+  std::uint32_t add_group() {
+    sums.emplace_back();
+    return groups.add();
+  }
+
+  void add_triangle(const Triangle& slots, std::uint32_t g) {
+    triangles.push_back(slots);
+    group.push_back(g);
+    for (Index s : slots) ++uses[s];
+  }
+
+  // Forgets a released point no live triangle uses.
+  void free_slot(std::uint32_t s) {
+    slot_of.erase(id[s]);
+    flags[s] = 0;
+    free_slots.push_back(s);
+  }
+};
+
+}  // namespace g2s
