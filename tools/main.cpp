@@ -1,5 +1,6 @@
 // g2s: the command-line tool. A thin layer over include/g2s/: parse, call, report.
 #include <fmt/core.h>
+#include <malloc.h>
 
 #include <exception>
 
@@ -15,6 +16,11 @@ int main(int argc, char** argv) {
       "folder, disk full); 5 no surface: the points cannot form one (none usable, all the same,\n"
       "two distinct, all on one line, too sparse), nothing written; 130 interrupted."};
   g2s::install_interrupt_cleanup();
+  // Tiles come and go in buffers of many sizes from several threads: served from mmap above a
+  // fixed size, they return to the system when freed, instead of glibc raising its threshold
+  // and keeping a fragmented heap that grows with the run (measured: +60% peak RSS at 40M
+  // points).
+  mallopt(M_MMAP_THRESHOLD, 1 << 20);
   app.require_subcommand(1);
   app.set_version_flag("--version", "g2s 0.1.0");
   g2s::cli::add_mesh_command(app);

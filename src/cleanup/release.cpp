@@ -4,6 +4,8 @@
 // no more except for the orientation of its group, decided at the very end.
 #include "cleanup/release.hpp"
 
+#include <utility>
+
 namespace g2s {
 namespace {
 
@@ -22,15 +24,15 @@ void add_to_sums(GroupSums& s, const std::array<const double*, 3>& xyz, const Ve
 
 void release_finished(LiveMesh& live, std::size_t step, const Vec3& origin, MeshSink& sink,
                       ReleaseCounts& counts) {
+  // Taken out of the lists (not cleared in place, which would keep their capacity).
+  const std::vector<std::uint32_t> finishing = std::exchange(live.finishing[step], {});
   std::vector<Index> suspects;
-  for (std::uint32_t s : live.finishing[step]) {
+  for (std::uint32_t s : finishing) {
     live.flags[s] |= LiveMesh::kFinished;
     if (live.flags[s] & LiveMesh::kSuspect) suspects.push_back(s);
   }
-  live.finishing[step] = {};
   // Slots that may be free once this step's triangles are gone.
-  std::vector<std::uint32_t> maybe_free = std::move(live.releasing[step]);
-  live.releasing[step] = {};
+  std::vector<std::uint32_t> maybe_free = std::exchange(live.releasing[step], {});
   for (std::uint32_t s : maybe_free) live.flags[s] |= LiveMesh::kReleased;
   std::vector<std::uint8_t> dead;
   if (!suspects.empty()) {

@@ -47,7 +47,7 @@ MappedFile::MappedFile(const std::filesystem::path& path, MapMode mode)
     const int populate = mode == MapMode::whole ? MAP_POPULATE : 0;
     void* map = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | populate, fd, 0);
     if (map == MAP_FAILED) fail_errno(name_, "cannot map", errno);
-    ::madvise(map, size_, MADV_SEQUENTIAL);
+    ::madvise(map, size_, mode == MapMode::random ? MADV_RANDOM : MADV_SEQUENTIAL);
     map_ = map;
     data_ = static_cast<const char*>(map);
     return;
@@ -80,10 +80,11 @@ void MappedFile::release_before(std::size_t offset) const {
 }
 
 void MappedFile::release(std::size_t begin, std::size_t end) const {
-  if (mode_ != MapMode::stream || map_ == nullptr) return;
+  if (mode_ == MapMode::whole || map_ == nullptr) return;
   const std::size_t page = static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
-  const std::size_t first = (begin + page - 1) / page * page;
-  const std::size_t last = std::min(end, size_) / page * page;
+  const std::size_t first = begin / page * page;
+  const std::size_t last =
+      std::min((end + page - 1) / page * page, (size_ + page - 1) / page * page);
   if (first < last) ::madvise(static_cast<char*>(map_) + first, last - first, MADV_DONTNEED);
 }
 

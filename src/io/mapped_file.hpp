@@ -17,7 +17,9 @@ namespace g2s::io {
 
 // whole: every page is read in at once (fastest when the caller keeps the whole cloud anyway).
 // stream: pages are read in as touched, and release_before() drops the consumed ones.
-enum class MapMode { whole, stream };
+// random: as stream, for reads here and there (a tile store's blocks): no readahead beyond the
+// pages touched, so release() leaves nothing of them behind.
+enum class MapMode { whole, stream, random };
 
 class MappedFile {
  public:
@@ -36,8 +38,9 @@ class MappedFile {
   // process's resident set (they stay in the page cache). Const because the view is unchanged:
   // a page touched again is read back in. A no-op in whole mode.
   void release_before(std::size_t offset) const;
-  // Stream mode: the whole pages inside [begin, end) leave the resident set (for random access,
-  // e.g. a tile store's blocks; safe while other threads read them: they are read back in).
+  // Stream or random mode: the pages overlapping [begin, end) leave the resident set (for random
+  // access, e.g. a tile store's blocks; safe while other threads read them, or read the
+  // neighbouring bytes of a page on the edge: they are read back in).
   void release(std::size_t begin, std::size_t end) const;
 
  private:

@@ -36,13 +36,14 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 
 // Seam widths at a tile, in the largest spacing around it (local_spacing): the band grown, the
 // context loaded around it, and how far from the tile's box a triangle made at its seam can
-// reach (a band point, or a corner of a live triangle touching one: a triangle's edges stay
-// within two search balls of max_radius spacings).
+// reach (a band point, or a corner of a live triangle touching one: an edge is at most about
+// a search ball of max_radius spacings, and a longer one is caught: the triangle is dropped
+// and counted).
 struct SeamReach {
   double band = 0;
   double context = 0;
   double touch = 0;
-  double margin = 0;  // the release margin beyond `touch`: the longest edge
+  double margin = 0;  // the release margin beyond `touch`: the longest edge (two search balls)
 };
 
 SeamReach seam_reach(std::span<const TileInfo> tiles, std::size_t tile,
@@ -52,8 +53,8 @@ SeamReach seam_reach(std::span<const TileInfo> tiles, std::size_t tile,
   SeamReach r;
   r.band = options.band_spacings * spacing;
   r.context = 2 * r.band;
+  r.touch = std::max(r.context, r.band + options.mesh.max_radius * spacing);
   r.margin = 2 * options.mesh.max_radius * spacing;
-  r.touch = std::max(r.context, r.band + r.margin);
   return r;
 }
 

@@ -50,7 +50,7 @@ struct TileStore::Impl {
   std::vector<std::uint64_t> frame_table_checksum;
 
   explicit Impl(const std::filesystem::path& store)
-      : path(store), file(store, io::MapMode::stream) {}
+      : path(store), file(store, io::MapMode::random) {}
 
   template <typename... Args>
   [[noreturn]] void fail(fmt::format_string<Args...> format, Args&&... args) const {
@@ -241,8 +241,12 @@ TilePoints TileStore::Impl::decode(std::size_t tile, const unsigned char* table,
     for (std::size_t k = 0; k < m; ++k) id[k] = load_le<std::uint32_t>(ids + k * sizeof(Index));
   }
   // The decoded copy is the caller's: the mapped pages need not stay resident (a pipeline
-  // loads every tile once; its memory should not grow to the size of the store).
-  file.release(block_offset[tile], block_offset[tile] + expected_offset);
+  // loads every tile once; its memory should not grow to the size of the store). The whole
+  // block goes, and the kernel's fault-around window past it: a fault maps up to 64 KiB of
+  // neighbouring pages, which a border load would otherwise leave behind, tile after tile.
+  constexpr std::uint64_t kFaultAround = 64 * 1024;
+  file.release(block_offset[tile] > kFaultAround ? block_offset[tile] - kFaultAround : 0,
+               block_offset[tile] + block_bytes[tile] + kFaultAround);
   if (frames == all_frames && expected_offset != block_bytes[tile]) {
     fail("tile {}: the frames end at byte {} of a {}-byte block (corrupt block)", tile,
          expected_offset, block_bytes[tile]);

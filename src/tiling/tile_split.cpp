@@ -109,17 +109,21 @@ void TileTree::split_range(std::uint32_t node, const PointSample& sample, std::u
 
 std::vector<std::uint32_t> TileTree::leaves() const {
   std::vector<std::uint32_t> out;
-  std::vector<std::uint32_t> stack = {0};
-  while (!stack.empty()) {
-    const std::uint32_t n = stack.back();
-    stack.pop_back();
-    if (is_leaf(n)) {
-      out.push_back(n);
-    } else {
-      stack.push_back(nodes_[n].right);
-      stack.push_back(nodes_[n].left);
-    }
+  for (std::uint32_t n = 0; n < nodes_.size(); ++n) {
+    if (is_leaf(n)) out.push_back(n);
   }
+  const TileBox& all = nodes_[0].box;
+  std::array<int, 3> axes = {0, 1, 2};
+  std::stable_sort(axes.begin(), axes.end(),
+                   [&](int a, int b) { return all.hi[a] - all.lo[a] > all.hi[b] - all.lo[b]; });
+  // Leaves do not overlap, so no two share a lower corner: the order is total.
+  std::sort(out.begin(), out.end(), [&](std::uint32_t a, std::uint32_t b) {
+    const TileBox &p = nodes_[a].box, &q = nodes_[b].box;
+    for (const int axis : axes) {
+      if (p.lo[axis] != q.lo[axis]) return p.lo[axis] < q.lo[axis];
+    }
+    return a < b;
+  });
   return out;
 }
 

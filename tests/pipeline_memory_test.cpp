@@ -1,0 +1,94 @@
+// The memory bound of `g2s mesh --memory`, in small (docs/pipeline.md, "Memory"; the full-size
+// measurement, 10M and 40M points under 512 MB, is bench/memory.py): two tori four times apart in
+// size, meshed under one small budget, stay under it, and the stitcher holds only the band along
+// its sweep front, which grows with the square root of the cloud; both meshes are closed and
+// clean. A budget too small to work with is refused up front.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+
+#include "temp_folder.hpp"
+
+namespace {
+
+using g2s::test_support::TempFolder;
+
+class PipelineMemory : public ::testing::Test {
+ protected:
+  PipelineMemory() : dir_("g2s-memory") {}
+
+  // Runs g2s with `args` in the test folder; returns the exit code, stdout in `out`.
+  int run(const std::string& args, std::string* out = nullptr) {
+    const std::string command = "cd \"" + dir_.path().string() + "\" && \"" + G2S_CLI_PATH + "\" " +
+                                args + " > stdout.txt 2> stderr.txt";
+    const int status = std::system(command.c_str());
+    std::ifstream file(dir_.path() / "stdout.txt");
+    std::stringstream text;
+    text << file.rdbuf();
+    if (out) *out = text.str();
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+
+  std::string stderr_text() {
+    std::ifstream file(dir_.path() / "stderr.txt");
+    std::stringstream text;
+    text << file.rdbuf();
+    return text.str();
+  }
+
+  static double number(const std::string& json, const std::string& key) {
+    const std::regex pattern("\"" + key + "\":\\s*([0-9.eE+-]+)");
+    std::smatch match;
+    if (!std::regex_search(json, match, pattern)) return -1;
+    return std::stod(match[1].str());
+  }
+
+  TempFolder dir_;
+};
+
+TEST_F(PipelineMemory, PeakStaysUnderTheBudgetAndTheStitcherHoldsOnlyItsFront) {
+  const double budget_mb = 96;
+  double live[2] = {0, 0};
+  const char* sizes[2] = {"400k", "1600k"};
+  const double points[2] = {400e3, 1600e3};
+  for (int k = 0; k < 2; ++k) {
+    const std::string cloud = std::string("torus-") + sizes[k] + ".ply";
+    ASSERT_EQ(run(std::string("synth torus -n ") + sizes[k] + " -o " + cloud), 0);
+    std::string json;
+    ASSERT_EQ(run("mesh " + cloud + " -o mesh.stl --memory 96M --threads 2 --json", &json), 0)
+        << stderr_text();
+    const double peak = number(json, "peak_rss_mb");
+    live[k] = number(json, "peak_live_points");
+    std::printf("%s points: %.0f tiles, peak %.1f MB, peak live points %.0f\n", sizes[k],
+                number(json, "tiles"), peak, live[k]);
+    EXPECT_GT(number(json, "tiles"), 4);
+    EXPECT_LT(peak, budget_mb);
+    EXPECT_LT(live[k], 0.25 * points[k]);
+    EXPECT_EQ(number(json, "seam_triangles_dropped"), 0);
+    EXPECT_EQ(number(json, "vertices_unjudged"), 0);
+    ASSERT_EQ(run("stats mesh.stl --json", &json), 0);
+    EXPECT_EQ(number(json, "non_manifold_edges"), 0);
+    EXPECT_EQ(number(json, "non_manifold_vertices"), 0);
+    EXPECT_EQ(number(json, "orientation_conflicts"), 0);
+    EXPECT_EQ(number(json, "boundary_edges"), 0);
+    EXPECT_EQ(number(json, "duplicate_triangles"), 0);
+  }
+  // The front of a sweep across a surface grows with the square root of its points: four times
+  // the points, about twice the live band (not four times).
+  EXPECT_LT(live[1], 2.2 * live[0]);
+}
+
+TEST_F(PipelineMemory, ABudgetTooSmallIsRefused) {
+  ASSERT_EQ(run("synth sphere -n 1000 -o sphere.ply"), 0);
+  EXPECT_EQ(run("mesh sphere.ply -o mesh.stl --memory 8M --threads 2"), 2);
+  EXPECT_NE(stderr_text().find("--memory 8 MB is too small"), std::string::npos) << stderr_text();
+  EXPECT_FALSE(std::filesystem::exists(dir_.path() / "mesh.stl"));
+}
+
+}  // namespace
