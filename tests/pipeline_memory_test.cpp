@@ -19,6 +19,20 @@ namespace {
 
 using g2s::test_support::TempFolder;
 
+// AddressSanitizer's shadow memory and quarantine multiply the resident set: under it only the
+// live band is checked, not the peak.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kMeasuresMemory = false;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kMeasuresMemory = false;
+#else
+constexpr bool kMeasuresMemory = true;
+#endif
+#else
+constexpr bool kMeasuresMemory = true;
+#endif
+
 class PipelineMemory : public ::testing::Test {
  protected:
   PipelineMemory() : dir_("g2s-memory") {}
@@ -68,7 +82,9 @@ TEST_F(PipelineMemory, PeakStaysUnderTheBudgetAndTheStitcherHoldsOnlyItsFront) {
     std::printf("%s points: %.0f tiles, peak %.1f MB, peak live points %.0f\n", sizes[k],
                 number(json, "tiles"), peak, live[k]);
     EXPECT_GT(number(json, "tiles"), 4);
-    EXPECT_LT(peak, budget_mb);
+    if (kMeasuresMemory) {
+      EXPECT_LT(peak, budget_mb);
+    }
     EXPECT_LT(live[k], 0.25 * points[k]);
     EXPECT_EQ(number(json, "seam_triangles_dropped"), 0);
     EXPECT_EQ(number(json, "vertices_unjudged"), 0);
