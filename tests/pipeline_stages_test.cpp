@@ -146,8 +146,13 @@ TEST(PipelineOwnership, EachTriangleIsKeptByOneTileOnly) {
   for (std::size_t t = 0; t < tiles.tiles().size(); ++t) {
     const g2s::TileGrowth g = g2s::grow_tile(tiles, t, {});
     EXPECT_GT(g.triangles.size(), 0u);
+    const std::vector<g2s::Index> ids = tiles.load(t).ids;  // corners index the tile's points
     for (g2s::Triangle tri : g.triangles) {
-      for (g2s::Index v : tri) ASSERT_EQ(tile_of[v], t);
+      for (g2s::Index& v : tri) {
+        ASSERT_LT(v, ids.size());
+        v = ids[v];
+        ASSERT_EQ(tile_of[v], t);
+      }
       std::sort(tri.begin(), tri.end());
       EXPECT_TRUE(seen.insert(tri).second);
     }

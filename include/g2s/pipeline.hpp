@@ -36,13 +36,15 @@ class MemoryTiles final : public TileSource {
   std::vector<std::vector<Index>> members_;  // per tile: ids of its points
 };
 
-// The first stage's result for one tile: the triangles it keeps (all corners in the tile).
+// The first stage's result for one tile: the triangles it keeps (all corners in the tile). Points
+// are given by their index among the tile's points as TileSource::load returns them (the
+// stitcher takes them in with no lookup by global id).
 struct TileGrowth {
-  std::vector<Triangle> triangles;   // global ids
+  std::vector<Triangle> triangles;   // indices into the tile's points
   std::vector<std::uint32_t> group;  // per triangle: orientation group, 0..groups-1
   std::uint32_t groups = 0;          // triangles of one group face consistently
-  // Global ids of the corners that may have more than one fan: where fronts met at a point,
-  // and corners of triangles left out because they reach into the halo.
+  // Corners (indices into the tile's points) that may have more than one fan: where fronts met
+  // at a point, and corners of triangles left out because they reach into the halo.
   std::vector<Index> second_fans;
   MeshReport report;
   // The tile's own points as grow_tile loaded them, handed on so the stitcher of the same

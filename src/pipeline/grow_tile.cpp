@@ -40,8 +40,10 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
     const int a = static_cast<int>(k % 3);
     local[k] = static_cast<float>(points.xyz[k] - 0.5 * (box.lo[a] + box.hi[a]));
   }
-  std::vector<Index> own_ids(points.ids.begin(), points.ids.begin() + static_cast<long>(own));
-  std::sort(own_ids.begin(), own_ids.end());
+  // Global id -> index among the tile's points, for the grid's points that are the tile's own.
+  std::vector<std::pair<Index, std::uint32_t>> own_index(own);
+  for (std::uint32_t k = 0; k < own; ++k) own_index[k] = {points.ids[k], k};
+  std::sort(own_index.begin(), own_index.end());
 
   const HashGrid grid(local, points.ids);
   out.report.points = own;
@@ -54,32 +56,37 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
   GrowResult grown = grow_mesh(grid, mesh_options);
   out.report.seeds = grown.seeds;
 
-  std::vector<std::uint8_t> mine(grid.size());
+  // Per grid point: its index among the tile's points, or kNoIndex for a halo point.
+  std::vector<Index> point_of(grid.size(), kNoIndex);
   std::uint64_t mine_count = 0;
   for (std::uint32_t k = 0; k < grid.size(); ++k) {
-    mine[k] = std::binary_search(own_ids.begin(), own_ids.end(), grid.id(k));
-    mine_count += mine[k];
+    const auto at = std::lower_bound(own_index.begin(), own_index.end(), std::pair{grid.id(k), 0u});
+    if (at != own_index.end() && at->first == grid.id(k)) {
+      point_of[k] = at->second;
+      ++mine_count;
+    }
   }
+  auto mine = [&](Index v) { return point_of[v] != kNoIndex; };
   out.report.duplicates_merged = own - mine_count;  // exact duplicates lie in one tile
   // Dense group numbers in order of first kept triangle: the same on every run.
   std::vector<std::uint32_t> dense(grown.triangles.size(), kNoIndex);
   for (std::size_t t = 0; t < grown.triangles.size(); ++t) {
     Triangle tri = grown.triangles[t];
-    if (!mine[tri[0]] || !mine[tri[1]] || !mine[tri[2]]) {
+    if (!mine(tri[0]) || !mine(tri[1]) || !mine(tri[2])) {
       // Leaving out a triangle that reaches into the halo can split a kept corner's fan in two.
       for (Index v : tri) {
-        if (mine[v]) out.second_fans.push_back(grid.id(v));
+        if (mine(v)) out.second_fans.push_back(point_of[v]);
       }
       continue;
     }
     if (grown.flip[t]) std::swap(tri[1], tri[2]);
     std::uint32_t& group = dense[grown.group[t]];
     if (group == kNoIndex) group = out.groups++;
-    out.triangles.push_back({grid.id(tri[0]), grid.id(tri[1]), grid.id(tri[2])});
+    out.triangles.push_back({point_of[tri[0]], point_of[tri[1]], point_of[tri[2]]});
     out.group.push_back(group);
   }
   for (Index v : grown.second_fans) {
-    if (mine[v]) out.second_fans.push_back(grid.id(v));
+    if (mine(v)) out.second_fans.push_back(point_of[v]);
   }
   out.report.triangles_grown = out.triangles.size();
   out.report.seconds_grow =

@@ -19,7 +19,7 @@ namespace g2s {
 namespace {
 
 constexpr char kMagic[8] = {'G', '2', 'S', 'G', 'R', 'O', 'W', '\0'};
-constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kVersion = 2;  // 2: corners as indices into the tile's points
 // magic, version, tile, fingerprint, triangles, groups, suspects, points, seeds, spacing,
 // duplicates, payload checksum, header checksum. No timings: the same tile gives the same bytes.
 constexpr std::size_t kHeaderBytes = 8 + 4 + 4 + 8 * 10;
@@ -123,7 +123,11 @@ TileGrowth read_tile_growth(const std::filesystem::path& file, std::uint32_t til
   g.report.duplicates_merged = tiling::load_le<std::uint64_t>(h + 72);
   g.triangles.resize(triangles);
   for (Triangle& t : g.triangles) {
-    for (Index& v : t) v = tiling::load_le<Index>(p), p += 4;
+    for (Index& v : t) {
+      v = tiling::load_le<Index>(p), p += 4;
+      if (v >= g.report.points)
+        throw fail("a triangle corner is out of range (the file is corrupt)");
+    }
   }
   g.group.resize(triangles);
   for (std::uint32_t& group : g.group) {
@@ -131,7 +135,10 @@ TileGrowth read_tile_growth(const std::filesystem::path& file, std::uint32_t til
     if (group >= groups) throw fail("a triangle's group is out of range (the file is corrupt)");
   }
   g.second_fans.resize(suspects);
-  for (Index& v : g.second_fans) v = tiling::load_le<Index>(p), p += 4;
+  for (Index& v : g.second_fans) {
+    v = tiling::load_le<Index>(p), p += 4;
+    if (v >= g.report.points) throw fail("a suspect corner is out of range (the file is corrupt)");
+  }
   g.report.triangles_grown = triangles;
   return g;
 }

@@ -48,8 +48,10 @@ struct LiveMesh {
 
   std::size_t capacity() const { return id.size(); }
 
-  // A point of the tile being added, finished after step `finish` and released after `release`.
-  void add_point(Index point, const double* p, std::uint32_t finish, std::uint32_t release) {
+  // A point of the tile being added, finished after step `finish` and released after `release`;
+  // returns its slot.
+  std::uint32_t add_point(Index point, const double* p, std::uint32_t finish,
+                          std::uint32_t release) {
     std::uint32_t s = 0;
     if (free_slots.empty()) {
       s = static_cast<std::uint32_t>(id.size());
@@ -73,6 +75,7 @@ struct LiveMesh {
     finishing[finish].push_back(s);
     releasing[release].push_back(s);
     peak_points = std::max(peak_points, slot_of.size());
+    return s;
   }
 
   // The slot of a live point, or IdMap::kMissing.

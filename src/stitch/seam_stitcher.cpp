@@ -285,10 +285,15 @@ void Stitcher::add(std::size_t tile, TileGrowth growth) {
   const auto start = std::chrono::steady_clock::now();
   const std::span<const TileInfo> tiles = m.source.tiles();
   LiveMesh& live = m.live;
+  std::vector<std::uint32_t> slot_of_point;  // per tile point: its slot
   {
     const TilePoints points = growth.points.size() == growth.report.points
                                   ? std::move(growth.points)
                                   : m.source.load(tile);
+    if (points.size() != growth.report.points) {
+      throw Error(Exit::bad_input, "grown tile: its point count differs from the tile store's");
+    }
+    slot_of_point.resize(points.size());
     std::vector<std::size_t> later;
     double inside = 0;
     for (std::size_t j = tile + 1; j < tiles.size(); ++j) {
@@ -306,25 +311,22 @@ void Stitcher::add(std::size_t tile, TileGrowth growth) {
       const std::uint32_t release = m.last_step(tile, p, later, inside, true);
       const std::uint32_t finish =
           release == tile ? release : m.last_step(tile, p, later, inside, false);
-      live.add_point(points.ids[k], p, finish, release);
+      slot_of_point[k] = live.add_point(points.ids[k], p, finish, release);
     }
   }
   const auto base = static_cast<std::uint32_t>(live.groups.size());
   for (std::uint32_t k = 0; k < growth.groups; ++k) live.add_group();
-  for (std::size_t k = 0; k < growth.triangles.size(); ++k) {
-    Triangle slots{};
-    for (int c = 0; c < 3; ++c) {
-      slots[c] = live.slot(growth.triangles[k][c]);
-      if (slots[c] == IdMap::kMissing) {
-        throw Error(Exit::bad_input, "grown tile: a triangle corner is not a point of its tile");
-      }
+  auto slot = [&](Index v) {
+    if (v >= slot_of_point.size()) {
+      throw Error(Exit::bad_input, "grown tile: a corner is not a point of its tile");
     }
-    live.add_triangle(slots, base + growth.group[k]);
+    return slot_of_point[v];
+  };
+  for (std::size_t k = 0; k < growth.triangles.size(); ++k) {
+    const Triangle& t = growth.triangles[k];
+    live.add_triangle({slot(t[0]), slot(t[1]), slot(t[2])}, base + growth.group[k]);
   }
-  for (Index v : growth.second_fans) {
-    const std::uint32_t s = live.slot(v);
-    if (s != IdMap::kMissing) live.flags[s] |= LiveMesh::kSuspect;
-  }
+  for (Index v : growth.second_fans) live.flags[slot(v)] |= LiveMesh::kSuspect;
   MeshReport& r = m.out.report;
   r.points += growth.report.points;
   r.seeds += growth.report.seeds;
