@@ -1,11 +1,12 @@
 // Flat hash grid for fixed-radius neighbour search (ALGORITHM.md §2). Points are sorted once
 // into Morton order of their cells (a radix sort), so a cell's points are contiguous and
 // neighbouring cells lie close in memory; non-empty cells are found through an open-addressing
-// hash of their Morton code, so empty space costs nothing. Exact duplicate points are merged
-// while sorting (the one with the smallest id is kept).
+// hash of their 4x4x4 blocks' Morton codes, so empty space costs nothing. Exact duplicate points
+// are merged while sorting (the one with the smallest id is kept).
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <span>
@@ -46,25 +47,27 @@ class HashGrid {
   std::int64_t cell_coord(double v, int axis) const {
     return static_cast<std::int64_t>(std::floor((v - origin_[axis]) * inv_cell_));
   }
-  // A hash slot: a non-empty cell's Morton code and its range of points_. One 16-byte slot per
-  // probe, so finding a cell's points costs one cache line.
-  struct Slot {
-    std::uint64_t code;
-    std::uint32_t begin, end;
+  // A 4x4x4 block of cells (the low 6 Morton bits of a cell) that holds points: which of its 64
+  // cells do, and where its first non-empty cell is in cell_begin_ (the block's cells follow in
+  // Morton order). One probe finds all 64 cells and an empty cell costs no memory access: a
+  // front query (2-3 cells per axis) touches a few blocks instead of probing every cell.
+  struct alignas(32) Block {
+    std::uint64_t code;   // the cells' Morton code >> 6
+    std::uint64_t cells;  // bit k: the cell with low Morton bits k holds points
+    std::uint32_t first;
   };
-  // The 4x4x4 block of cells around a cell (the low 6 Morton bits) shares one 64-slot region:
-  // a query's neighbouring cells are found in the same few cache lines.
-  std::uint64_t slot_of(std::uint64_t code) const {
-    return (((code >> 6) * 0x9E3779B97F4A7C15ull) >> slot_shift_ << 6 | (code & 63)) & slot_mask_;
+  std::uint64_t slot_of(std::uint64_t block) const {
+    return (block * 0x9E3779B97F4A7C15ull) >> slot_shift_;  // the top bits are the best mixed
   }
-  const Slot* find_cell(std::uint64_t code) const;
+  const Block* find_block(std::uint64_t block) const;
 
   std::vector<Vec3f> points_;
   std::vector<Index> ids_;
-  std::vector<std::uint32_t> cell_start_;  // while building: cells + 1 offsets into points_
-  std::vector<Slot> slots_;                // open addressing, linear probing, load <= 1/2
+  std::vector<std::uint32_t>
+      cell_begin_;             // non-empty cells in Morton order, + 1: offsets into points_
+  std::vector<Block> blocks_;  // open addressing, linear probing, load <= 1/2
   std::uint64_t slot_mask_ = 0;
-  int slot_shift_ = 64;  // 64 - log2(slots / 64): the top bits of the product are the best mixed
+  int slot_shift_ = 64;           // 64 - log2(blocks_.size())
   double origin_[3] = {0, 0, 0};  // bounding box: lowest corner
   double extent_[3] = {0, 0, 0};  // and size
   double cell_ = 1.0;
@@ -88,11 +91,11 @@ inline std::uint64_t morton3(std::uint64_t x, std::uint64_t y, std::uint64_t z) 
   return spread(x) | spread(y) << 1 | spread(z) << 2;
 }
 
-inline const HashGrid::Slot* HashGrid::find_cell(std::uint64_t code) const {
-  for (std::uint64_t slot = slot_of(code);; slot = (slot + 1) & slot_mask_) {
-    const Slot& s = slots_[slot];
-    if (s.code == code) return &s;
-    if (s.code == ~0ull) return nullptr;
+inline const HashGrid::Block* HashGrid::find_block(std::uint64_t block) const {
+  for (std::uint64_t slot = slot_of(block);; slot = (slot + 1) & slot_mask_) {
+    const Block& b = blocks_[slot];
+    if (b.code == block) return &b;
+    if (b.code == ~0ull) return nullptr;
   }
 }
 
@@ -132,6 +135,9 @@ void HashGrid::for_each_in_ball(const Vec3& centre, double radius, Visit&& visit
     const double rz = std::sqrt(rz2);
     const std::int64_t y0 = std::max<std::int64_t>(cell_coord(centre.y - rz, 1), 0);
     const std::int64_t y1 = std::min<std::int64_t>(cell_coord(centre.y + rz, 1), dims_[1] - 1);
+    // Consecutive cells of a row mostly share a block: look it up once.
+    std::uint64_t block_code = ~0ull;
+    const Block* block = nullptr;
     for (std::int64_t y = y0; y <= y1; ++y) {
       const double gy = gap(y, centre.y, 1);
       const double ry2 = rz2 - gy * gy;
@@ -140,11 +146,16 @@ void HashGrid::for_each_in_ball(const Vec3& centre, double radius, Visit&& visit
       const std::int64_t x0 = std::max<std::int64_t>(cell_coord(centre.x - ry, 0), 0);
       const std::int64_t x1 = std::min<std::int64_t>(cell_coord(centre.x + ry, 0), dims_[0] - 1);
       for (std::int64_t x = x0; x <= x1; ++x) {
-        const Slot* cell =
-            find_cell(morton3(static_cast<std::uint64_t>(x), static_cast<std::uint64_t>(y),
-                              static_cast<std::uint64_t>(z)));
-        if (!cell) continue;
-        for (std::uint32_t i = cell->begin, end = cell->end; i < end; ++i) {
+        const std::uint64_t code =
+            morton3(static_cast<std::uint64_t>(x), static_cast<std::uint64_t>(y),
+                    static_cast<std::uint64_t>(z));
+        if (code >> 6 != block_code) block_code = code >> 6, block = find_block(block_code);
+        if (!block) continue;
+        const std::uint64_t bit = std::uint64_t{1} << (code & 63);
+        if (!(block->cells & bit)) continue;
+        const std::size_t k =
+            block->first + static_cast<std::size_t>(std::popcount(block->cells & (bit - 1)));
+        for (std::uint32_t i = cell_begin_[k], end = cell_begin_[k + 1]; i < end; ++i) {
           const Vec3f& p = points_[i];
           const double dx = p.x - centre.x, dy = p.y - centre.y, dz = p.z - centre.z;
           const double d2 = dx * dx + dy * dy + dz * dz;
