@@ -6,9 +6,9 @@
 #pragma once
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <span>
 #include <vector>
 
@@ -47,6 +47,13 @@ class HashGrid {
   std::int64_t cell_coord(double v, int axis) const {
     return static_cast<std::int64_t>(std::floor((v - origin_[axis]) * inv_cell_));
   }
+  // cell_coord clamped to the grid; clamped first, so that a cast rounds the same as floor (no
+  // call to floor: queries compute several per row).
+  std::int64_t clamped_coord(double v, int axis) const {
+    const double c = (v - origin_[axis]) * inv_cell_;
+    return static_cast<std::int64_t>(
+        std::min(std::max(c, 0.0), static_cast<double>(dims_[axis] - 1)));
+  }
   // A 4x4x4 block of cells (the low 6 Morton bits of a cell) that holds points: which of its 64
   // cells do, and where its first non-empty cell is in cell_begin_ (the block's cells follow in
   // Morton order). One probe finds all 64 cells and an empty cell costs no memory access: a
@@ -76,6 +83,15 @@ class HashGrid {
   double spacing_ = 0.0;
   std::uint64_t duplicates_ = 0;
 };
+
+// std::popcount without a library call on targets built without a popcount instruction (the
+// default x86-64 build calls libgcc for it, a measurable cost in ball queries).
+inline std::size_t bit_count(std::uint64_t v) {
+  v -= v >> 1 & 0x5555555555555555ull;
+  v = (v & 0x3333333333333333ull) + (v >> 2 & 0x3333333333333333ull);
+  v = (v + (v >> 4)) & 0x0f0f0f0f0f0f0f0full;
+  return static_cast<std::size_t>(v * 0x0101010101010101ull >> 56);
+}
 
 // Interleaves the low 21 bits of x, y, z.
 inline std::uint64_t morton3(std::uint64_t x, std::uint64_t y, std::uint64_t z) {
@@ -108,16 +124,15 @@ void HashGrid::for_each_in_ball(const Vec3& centre, double radius, Visit&& visit
     const double lo = origin_[axis] + static_cast<double>(cell) * cell_;
     return c < lo ? lo - c : std::max(0.0, c - (lo + cell_));
   };
-  const std::int64_t z0 = std::max<std::int64_t>(cell_coord(centre.z - radius, 2), 0);
-  const std::int64_t z1 = std::min<std::int64_t>(cell_coord(centre.z + radius, 2), dims_[2] - 1);
+  const std::int64_t z0 = clamped_coord(centre.z - radius, 2);
+  const std::int64_t z1 = clamped_coord(centre.z + radius, 2);
   // A ball spanning more cells than there are points (far outliers, very uneven density) is
   // cheaper to answer by scanning the points than by probing mostly empty cells.
   double box_cells = static_cast<double>(z1 - z0 + 1);
   for (int a = 0; a < 2; ++a) {
     const double c = a == 0 ? centre.x : centre.y;
     box_cells *=
-        static_cast<double>(std::min<std::int64_t>(cell_coord(c + radius, a), dims_[a] - 1) -
-                            std::max<std::int64_t>(cell_coord(c - radius, a), 0) + 1);
+        static_cast<double>(clamped_coord(c + radius, a) - clamped_coord(c - radius, a) + 1);
   }
   if (box_cells > static_cast<double>(points_.size())) {
     for (std::uint32_t i = 0; i < points_.size(); ++i) {
@@ -128,42 +143,59 @@ void HashGrid::for_each_in_ball(const Vec3& centre, double radius, Visit&& visit
     }
     return;
   }
+  // Points found are buffered and visited in order after the scan: the inside test then has
+  // no unpredictable branch (it decides only whether the buffer slot is kept).
+  std::uint32_t found[64];
+  double found_d2[64];
+  std::size_t count = 0;
+  const auto flush = [&] {
+    for (std::size_t f = 0; f < count; ++f) visit(found[f], found_d2[f]);
+    count = 0;
+  };
+  // The query's blocks, each looked up once: they are told apart by the parities of their
+  // coordinates (a query spans at most two blocks per axis unless its radius exceeds a block).
+  std::uint64_t block_code[8];
+  const Block* block_of[8] = {};
+  std::fill(std::begin(block_code), std::end(block_code), ~0ull);
   for (std::int64_t z = z0; z <= z1; ++z) {
     const double gz = gap(z, centre.z, 2);
     const double rz2 = r2 - gz * gz;
     if (rz2 < 0) continue;
     const double rz = std::sqrt(rz2);
-    const std::int64_t y0 = std::max<std::int64_t>(cell_coord(centre.y - rz, 1), 0);
-    const std::int64_t y1 = std::min<std::int64_t>(cell_coord(centre.y + rz, 1), dims_[1] - 1);
-    // Consecutive cells of a row mostly share a block: look it up once.
-    std::uint64_t block_code = ~0ull;
-    const Block* block = nullptr;
+    const std::int64_t y0 = clamped_coord(centre.y - rz, 1);
+    const std::int64_t y1 = clamped_coord(centre.y + rz, 1);
+    const std::uint64_t code_z = morton3(0, 0, static_cast<std::uint64_t>(z));
     for (std::int64_t y = y0; y <= y1; ++y) {
       const double gy = gap(y, centre.y, 1);
       const double ry2 = rz2 - gy * gy;
       if (ry2 < 0) continue;
       const double ry = std::sqrt(ry2);
-      const std::int64_t x0 = std::max<std::int64_t>(cell_coord(centre.x - ry, 0), 0);
-      const std::int64_t x1 = std::min<std::int64_t>(cell_coord(centre.x + ry, 0), dims_[0] - 1);
+      const std::int64_t x0 = clamped_coord(centre.x - ry, 0);
+      const std::int64_t x1 = clamped_coord(centre.x + ry, 0);
+      const std::uint64_t code_yz = code_z | morton3(0, static_cast<std::uint64_t>(y), 0);
       for (std::int64_t x = x0; x <= x1; ++x) {
-        const std::uint64_t code =
-            morton3(static_cast<std::uint64_t>(x), static_cast<std::uint64_t>(y),
-                    static_cast<std::uint64_t>(z));
-        if (code >> 6 != block_code) block_code = code >> 6, block = find_block(block_code);
+        const std::uint64_t code = code_yz | morton3(static_cast<std::uint64_t>(x), 0, 0);
+        const std::uint64_t bc = code >> 6;
+        const std::size_t slot = (bc & 1) | (bc >> 2 & 2) | (bc >> 4 & 4);
+        if (block_code[slot] != bc) block_code[slot] = bc, block_of[slot] = find_block(bc);
+        const Block* block = block_of[slot];
         if (!block) continue;
         const std::uint64_t bit = std::uint64_t{1} << (code & 63);
         if (!(block->cells & bit)) continue;
-        const std::size_t k =
-            block->first + static_cast<std::size_t>(std::popcount(block->cells & (bit - 1)));
+        const std::size_t k = block->first + bit_count(block->cells & (bit - 1));
         for (std::uint32_t i = cell_begin_[k], end = cell_begin_[k + 1]; i < end; ++i) {
           const Vec3f& p = points_[i];
           const double dx = p.x - centre.x, dy = p.y - centre.y, dz = p.z - centre.z;
           const double d2 = dx * dx + dy * dy + dz * dz;
-          if (d2 <= r2) visit(i, d2);
+          found[count] = i;
+          found_d2[count] = d2;
+          count += d2 <= r2;
+          if (count == std::size(found)) flush();
         }
       }
     }
   }
+  flush();
 }
 
 template <class Keep>
