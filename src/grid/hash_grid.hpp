@@ -6,6 +6,8 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <iterator>
@@ -47,13 +49,12 @@ class HashGrid {
   std::int64_t cell_coord(double v, int axis) const {
     return static_cast<std::int64_t>(std::floor((v - origin_[axis]) * inv_cell_));
   }
-  // The coordinate of the query cell (2x2x2 cells) holding v, clamped to the grid; clamped
-  // first, so that a cast rounds the same as floor (no call to floor: queries compute several
-  // per row).
-  std::int64_t query_coord(double v, int axis) const {
-    const double c = (v - origin_[axis]) * (0.5 * inv_cell_);
+  // cell_coord clamped to the grid; clamped first, so that a cast rounds the same as floor (no
+  // call to floor).
+  std::int64_t clamped_coord(double v, int axis) const {
+    const double c = (v - origin_[axis]) * inv_cell_;
     return static_cast<std::int64_t>(
-        std::min(std::max(c, 0.0), static_cast<double>((dims_[axis] - 1) / 2)));
+        std::min(std::max(c, 0.0), static_cast<double>(dims_[axis] - 1)));
   }
   // A 4x4x4 block of cells (the low 6 Morton bits of a cell) that holds points: which of its 64
   // cells do, and where its first non-empty cell is in cell_begin_ (the block's cells follow in
@@ -116,28 +117,29 @@ inline const HashGrid::Block* HashGrid::find_block(std::uint64_t block) const {
   }
 }
 
+// The cells of a 4x4x4 block whose coordinate along `axis` lies in [lo, hi] (0..3), as a mask
+// over the block's 64 cells in Morton order (bit k: low Morton bits k).
+constexpr std::uint64_t block_slab(int axis, int lo, int hi) {
+  std::uint64_t mask = 0;
+  for (int k = 0; k < 64; ++k) {
+    const int v = (k >> axis & 1) | (k >> (axis + 3) & 1) << 1;
+    if (v >= lo && v <= hi) mask |= std::uint64_t{1} << k;
+  }
+  return mask;
+}
+
 template <class Visit>
 void HashGrid::for_each_in_ball(const Vec3& centre, double radius, Visit&& visit) const {
   const double r2 = radius * radius;
-  // Queries visit cells of 2x2x2 grid cells (6 spacings): their 8 cells are consecutive in Morton
-  // order, so their points are one range, found from the block's mask. The grid's own cells (3
-  // spacings) give the point order (and so the seeds' order and every tie-break by index); a
-  // front query, typically 1-2 spacings in radius on noisy scans, costs less over fewer,
-  // fuller cells. Only the cells the ball touches: per z slab and y row, the x range shrinks to
-  // the ball's chord there.
-  const double size = 2 * cell_;
-  auto gap = [&](std::int64_t cell, double c, int axis) {  // distance from c to a cell's span
-    const double lo = origin_[axis] + static_cast<double>(cell) * size;
-    return c < lo ? lo - c : std::max(0.0, c - (lo + size));
-  };
-  const std::int64_t z0 = query_coord(centre.z - radius, 2);
-  const std::int64_t z1 = query_coord(centre.z + radius, 2);
+  const double c[3] = {centre.x, centre.y, centre.z};
+  std::int64_t lo[3], hi[3];
   // A ball spanning more cells than there are points (far outliers, very uneven density) is
   // cheaper to answer by scanning the points than by probing mostly empty cells.
-  double box_cells = static_cast<double>(z1 - z0 + 1);
-  for (int a = 0; a < 2; ++a) {
-    const double c = a == 0 ? centre.x : centre.y;
-    box_cells *= static_cast<double>(query_coord(c + radius, a) - query_coord(c - radius, a) + 1);
+  double box_cells = 1;
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = clamped_coord(c[a] - radius, a);
+    hi[a] = clamped_coord(c[a] + radius, a);
+    box_cells *= static_cast<double>(hi[a] - lo[a] + 1);
   }
   if (box_cells > static_cast<double>(points_.size())) {
     for (std::uint32_t i = 0; i < points_.size(); ++i) {
@@ -148,6 +150,21 @@ void HashGrid::for_each_in_ball(const Vec3& centre, double radius, Visit&& visit
     }
     return;
   }
+  static constexpr auto kSlabs = [] {
+    std::array<std::array<std::array<std::uint64_t, 4>, 4>, 3> slabs{};
+    for (int a = 0; a < 3; ++a) {
+      for (int l = 0; l < 4; ++l) {
+        for (int h = l; h < 4; ++h) slabs[a][l][h] = block_slab(a, l, h);
+      }
+    }
+    return slabs;
+  }();
+  // The block's cells in the query's box along one axis.
+  const auto slab = [&](int a, std::int64_t block) {
+    const std::int64_t first = 4 * block;
+    return kSlabs[a][std::max<std::int64_t>(lo[a] - first, 0)]
+                 [std::min<std::int64_t>(hi[a] - first, 3)];
+  };
   // Points found are buffered and visited after the scan: the inside test then has no
   // unpredictable branch (it decides only whether the buffer slot is kept).
   std::uint32_t found[64];
@@ -157,50 +174,35 @@ void HashGrid::for_each_in_ball(const Vec3& centre, double radius, Visit&& visit
     for (std::size_t f = 0; f < count; ++f) visit(found[f], found_d2[f]);
     count = 0;
   };
-  // The query's blocks (2x2x2 query cells each), each looked up once: they are told apart by the
-  // parities of their coordinates (a query spans at most two blocks per axis unless its radius
-  // exceeds a block).
-  std::uint64_t block_code[8];
-  const Block* block_of[8] = {};
-  std::fill(std::begin(block_code), std::end(block_code), ~0ull);
-  for (std::int64_t z = z0; z <= z1; ++z) {
-    const double gz = gap(z, centre.z, 2);
-    const double rz2 = r2 - gz * gz;
-    if (rz2 < 0) continue;
-    const double rz = std::sqrt(rz2);
-    const std::int64_t y0 = query_coord(centre.y - rz, 1);
-    const std::int64_t y1 = query_coord(centre.y + rz, 1);
-    const std::uint64_t code_z = morton3(0, 0, static_cast<std::uint64_t>(2 * z));
-    for (std::int64_t y = y0; y <= y1; ++y) {
-      const double gy = gap(y, centre.y, 1);
-      const double ry2 = rz2 - gy * gy;
-      if (ry2 < 0) continue;
-      const double ry = std::sqrt(ry2);
-      const std::int64_t x0 = query_coord(centre.x - ry, 0);
-      const std::int64_t x1 = query_coord(centre.x + ry, 0);
-      const std::uint64_t code_yz = code_z | morton3(0, static_cast<std::uint64_t>(2 * y), 0);
-      for (std::int64_t x = x0; x <= x1; ++x) {
-        // The Morton code of the query cell's first grid cell; its 8 cells follow.
-        const std::uint64_t code = code_yz | morton3(static_cast<std::uint64_t>(2 * x), 0, 0);
-        const std::uint64_t bc = code >> 6;
-        const std::size_t slot = (bc & 1) | (bc >> 2 & 2) | (bc >> 4 & 4);
-        if (block_code[slot] != bc) block_code[slot] = bc, block_of[slot] = find_block(bc);
-        const Block* block = block_of[slot];
+  // Block by block, the non-empty cells in the query's box come from the masks at once; cells
+  // consecutive in Morton order have consecutive points, so each run of them is one range.
+  for (std::int64_t bz = lo[2] >> 2; bz <= hi[2] >> 2; ++bz) {
+    const std::uint64_t mask_z = slab(2, bz);
+    for (std::int64_t by = lo[1] >> 2; by <= hi[1] >> 2; ++by) {
+      const std::uint64_t mask_yz = mask_z & slab(1, by);
+      for (std::int64_t bx = lo[0] >> 2; bx <= hi[0] >> 2; ++bx) {
+        const Block* block =
+            find_block(morton3(static_cast<std::uint64_t>(bx), static_cast<std::uint64_t>(by),
+                               static_cast<std::uint64_t>(bz)));
         if (!block) continue;
-        const unsigned shift = code & 63;
-        const std::uint64_t cells = block->cells >> shift & 0xFF;
-        if (!cells) continue;
-        const std::size_t k =
-            block->first + bit_count(block->cells & ((std::uint64_t{1} << shift) - 1));
-        for (std::uint32_t i = cell_begin_[k], end = cell_begin_[k + bit_count(cells)]; i < end;
-             ++i) {
-          const Vec3f& p = points_[i];
-          const double dx = p.x - centre.x, dy = p.y - centre.y, dz = p.z - centre.z;
-          const double d2 = dx * dx + dy * dy + dz * dz;
-          found[count] = i;
-          found_d2[count] = d2;
-          count += d2 <= r2;
-          if (count == std::size(found)) flush();
+        std::uint64_t cells = block->cells & mask_yz & slab(0, bx);
+        while (cells) {
+          const int start = std::countr_zero(cells);
+          const int run = std::countr_one(cells >> start);
+          const std::size_t k =
+              block->first + bit_count(block->cells & ((std::uint64_t{1} << start) - 1));
+          cells = start + run >= 64 ? 0 : cells & (~0ull << (start + run));
+          for (std::uint32_t i = cell_begin_[k],
+                             end = cell_begin_[k + static_cast<std::size_t>(run)];
+               i < end; ++i) {
+            const Vec3f& p = points_[i];
+            const double dx = p.x - centre.x, dy = p.y - centre.y, dz = p.z - centre.z;
+            const double d2 = dx * dx + dy * dy + dz * dz;
+            found[count] = i;
+            found_d2[count] = d2;
+            count += d2 <= r2;
+            if (count == std::size(found)) flush();
+          }
         }
       }
     }
