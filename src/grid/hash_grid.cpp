@@ -1,5 +1,5 @@
 // Builds the hash grid: cell size from the sampling spacing, points radix-sorted into Morton
-// order of their cells, duplicates merged, and the cell hash filled. See hash_grid.hpp.
+// order of their cells, duplicates merged, and the block hash filled. See hash_grid.hpp.
 #include "grid/hash_grid.hpp"
 
 #include <bit>
@@ -118,7 +118,7 @@ void HashGrid::build(std::span<const float> xyz, std::span<const Index> ids, dou
 
   points_.clear();
   ids_.clear();
-  cell_start_.clear();
+  cell_begin_.clear();
   points_.reserve(n);
   ids_.reserve(n);
   std::vector<std::uint64_t> cell_codes;
@@ -130,7 +130,7 @@ void HashGrid::build(std::span<const float> xyz, std::span<const Index> ids, dou
     while (end < n && codes[end] == codes[begin]) ++end;
     std::sort(order.begin() + begin, order.begin() + end, less);
     cell_codes.push_back(codes[begin]);
-    cell_start_.push_back(static_cast<std::uint32_t>(points_.size()));
+    cell_begin_.push_back(static_cast<std::uint32_t>(points_.size()));
     for (std::size_t k = begin; k < end; ++k) {
       const std::uint32_t i = order[k];
       if (k > begin && same(i, order[k - 1])) {
@@ -142,20 +142,26 @@ void HashGrid::build(std::span<const float> xyz, std::span<const Index> ids, dou
     }
     begin = end;
   }
-  cell_start_.push_back(static_cast<std::uint32_t>(points_.size()));
+  cell_begin_.push_back(static_cast<std::uint32_t>(points_.size()));
 
-  std::size_t slots = 128;  // at least two 64-slot regions, so slot_shift_ stays below 64
-  while (slots < 2 * cell_codes.size()) slots *= 2;
-  slot_mask_ = slots - 1;
-  slot_shift_ = 64 - std::countr_zero(slots / 64);
-  slots_.assign(slots, Slot{kEmpty, 0, 0});
+  // Blocks in Morton order: a block's cells are consecutive in cell_codes.
+  std::vector<Block> blocks;
   for (std::size_t c = 0; c < cell_codes.size(); ++c) {
-    std::uint64_t slot = slot_of(cell_codes[c]);
-    while (slots_[slot].code != kEmpty) slot = (slot + 1) & slot_mask_;
-    slots_[slot] = {cell_codes[c], cell_start_[c], cell_start_[c + 1]};
+    if (blocks.empty() || blocks.back().code != cell_codes[c] >> 6) {
+      blocks.push_back({cell_codes[c] >> 6, 0, static_cast<std::uint32_t>(c)});
+    }
+    blocks.back().cells |= std::uint64_t{1} << (cell_codes[c] & 63);
   }
-  cell_start_.clear();
-  cell_start_.shrink_to_fit();
+  std::size_t slots = 16;
+  while (slots < 2 * blocks.size()) slots *= 2;
+  slot_mask_ = slots - 1;
+  slot_shift_ = 64 - std::countr_zero(slots);
+  blocks_.assign(slots, Block{kEmpty, 0, 0});
+  for (const Block& b : blocks) {
+    std::uint64_t slot = slot_of(b.code);
+    while (blocks_[slot].code != kEmpty) slot = (slot + 1) & slot_mask_;
+    blocks_[slot] = b;
+  }
 }
 
 double HashGrid::estimate_spacing() const {

@@ -1,13 +1,16 @@
 // Flat hash grid for fixed-radius neighbour search (ALGORITHM.md §2). Points are sorted once
 // into Morton order of their cells (a radix sort), so a cell's points are contiguous and
 // neighbouring cells lie close in memory; non-empty cells are found through an open-addressing
-// hash of their Morton code, so empty space costs nothing. Exact duplicate points are merged
-// while sorting (the one with the smallest id is kept).
+// hash of their 4x4x4 blocks' Morton codes, so empty space costs nothing. Exact duplicate points
+// are merged while sorting (the one with the smallest id is kept).
 #pragma once
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <span>
 #include <vector>
 
@@ -46,25 +49,34 @@ class HashGrid {
   std::int64_t cell_coord(double v, int axis) const {
     return static_cast<std::int64_t>(std::floor((v - origin_[axis]) * inv_cell_));
   }
-  // A hash slot: a non-empty cell's Morton code and its range of points_. One 16-byte slot per
-  // probe, so finding a cell's points costs one cache line.
-  struct Slot {
-    std::uint64_t code;
-    std::uint32_t begin, end;
-  };
-  // The 4x4x4 block of cells around a cell (the low 6 Morton bits) shares one 64-slot region:
-  // a query's neighbouring cells are found in the same few cache lines.
-  std::uint64_t slot_of(std::uint64_t code) const {
-    return (((code >> 6) * 0x9E3779B97F4A7C15ull) >> slot_shift_ << 6 | (code & 63)) & slot_mask_;
+  // cell_coord clamped to the grid; clamped first, so that a cast rounds the same as floor (no
+  // call to floor).
+  std::int64_t clamped_coord(double v, int axis) const {
+    const double c = (v - origin_[axis]) * inv_cell_;
+    return static_cast<std::int64_t>(
+        std::min(std::max(c, 0.0), static_cast<double>(dims_[axis] - 1)));
   }
-  const Slot* find_cell(std::uint64_t code) const;
+  // A 4x4x4 block of cells (the low 6 Morton bits of a cell) that holds points: which of its 64
+  // cells do, and where its first non-empty cell is in cell_begin_ (the block's cells follow in
+  // Morton order). One probe finds all 64 cells and an empty cell costs no memory access: a
+  // front query (2-3 cells per axis) touches a few blocks instead of probing every cell.
+  struct alignas(32) Block {
+    std::uint64_t code;   // the cells' Morton code >> 6
+    std::uint64_t cells;  // bit k: the cell with low Morton bits k holds points
+    std::uint32_t first;
+  };
+  std::uint64_t slot_of(std::uint64_t block) const {
+    return (block * 0x9E3779B97F4A7C15ull) >> slot_shift_;  // the top bits are the best mixed
+  }
+  const Block* find_block(std::uint64_t block) const;
 
   std::vector<Vec3f> points_;
   std::vector<Index> ids_;
-  std::vector<std::uint32_t> cell_start_;  // while building: cells + 1 offsets into points_
-  std::vector<Slot> slots_;                // open addressing, linear probing, load <= 1/2
+  std::vector<std::uint32_t>
+      cell_begin_;             // non-empty cells in Morton order, + 1: offsets into points_
+  std::vector<Block> blocks_;  // open addressing, linear probing, load <= 1/2
   std::uint64_t slot_mask_ = 0;
-  int slot_shift_ = 64;  // 64 - log2(slots / 64): the top bits of the product are the best mixed
+  int slot_shift_ = 64;           // 64 - log2(blocks_.size())
   double origin_[3] = {0, 0, 0};  // bounding box: lowest corner
   double extent_[3] = {0, 0, 0};  // and size
   double cell_ = 1.0;
@@ -73,6 +85,15 @@ class HashGrid {
   double spacing_ = 0.0;
   std::uint64_t duplicates_ = 0;
 };
+
+// std::popcount without a library call on targets built without a popcount instruction (the
+// default x86-64 build calls libgcc for it, a measurable cost in ball queries).
+inline std::size_t bit_count(std::uint64_t v) {
+  v -= v >> 1 & 0x5555555555555555ull;
+  v = (v & 0x3333333333333333ull) + (v >> 2 & 0x3333333333333333ull);
+  v = (v + (v >> 4)) & 0x0f0f0f0f0f0f0f0full;
+  return static_cast<std::size_t>(v * 0x0101010101010101ull >> 56);
+}
 
 // Interleaves the low 21 bits of x, y, z.
 inline std::uint64_t morton3(std::uint64_t x, std::uint64_t y, std::uint64_t z) {
@@ -88,33 +109,37 @@ inline std::uint64_t morton3(std::uint64_t x, std::uint64_t y, std::uint64_t z) 
   return spread(x) | spread(y) << 1 | spread(z) << 2;
 }
 
-inline const HashGrid::Slot* HashGrid::find_cell(std::uint64_t code) const {
-  for (std::uint64_t slot = slot_of(code);; slot = (slot + 1) & slot_mask_) {
-    const Slot& s = slots_[slot];
-    if (s.code == code) return &s;
-    if (s.code == ~0ull) return nullptr;
+inline const HashGrid::Block* HashGrid::find_block(std::uint64_t block) const {
+  for (std::uint64_t slot = slot_of(block);; slot = (slot + 1) & slot_mask_) {
+    const Block& b = blocks_[slot];
+    if (b.code == block) return &b;
+    if (b.code == ~0ull) return nullptr;
   }
+}
+
+// The cells of a 4x4x4 block whose coordinate along `axis` lies in [lo, hi] (0..3), as a mask
+// over the block's 64 cells in Morton order (bit k: low Morton bits k).
+constexpr std::uint64_t block_slab(int axis, int lo, int hi) {
+  std::uint64_t mask = 0;
+  for (int k = 0; k < 64; ++k) {
+    const int v = (k >> axis & 1) | (k >> (axis + 3) & 1) << 1;
+    if (v >= lo && v <= hi) mask |= std::uint64_t{1} << k;
+  }
+  return mask;
 }
 
 template <class Visit>
 void HashGrid::for_each_in_ball(const Vec3& centre, double radius, Visit&& visit) const {
   const double r2 = radius * radius;
-  // Only the cells the ball touches: per z slab and y row, the x range shrinks to the ball's
-  // chord there, so a large ball visits about half the cells of its bounding cube.
-  auto gap = [&](std::int64_t cell, double c, int axis) {  // distance from c to a cell's span
-    const double lo = origin_[axis] + static_cast<double>(cell) * cell_;
-    return c < lo ? lo - c : std::max(0.0, c - (lo + cell_));
-  };
-  const std::int64_t z0 = std::max<std::int64_t>(cell_coord(centre.z - radius, 2), 0);
-  const std::int64_t z1 = std::min<std::int64_t>(cell_coord(centre.z + radius, 2), dims_[2] - 1);
+  const double c[3] = {centre.x, centre.y, centre.z};
+  std::int64_t lo[3], hi[3];
   // A ball spanning more cells than there are points (far outliers, very uneven density) is
   // cheaper to answer by scanning the points than by probing mostly empty cells.
-  double box_cells = static_cast<double>(z1 - z0 + 1);
-  for (int a = 0; a < 2; ++a) {
-    const double c = a == 0 ? centre.x : centre.y;
-    box_cells *=
-        static_cast<double>(std::min<std::int64_t>(cell_coord(c + radius, a), dims_[a] - 1) -
-                            std::max<std::int64_t>(cell_coord(c - radius, a), 0) + 1);
+  double box_cells = 1;
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = clamped_coord(c[a] - radius, a);
+    hi[a] = clamped_coord(c[a] + radius, a);
+    box_cells *= static_cast<double>(hi[a] - lo[a] + 1);
   }
   if (box_cells > static_cast<double>(points_.size())) {
     for (std::uint32_t i = 0; i < points_.size(); ++i) {
@@ -125,34 +150,64 @@ void HashGrid::for_each_in_ball(const Vec3& centre, double radius, Visit&& visit
     }
     return;
   }
-  for (std::int64_t z = z0; z <= z1; ++z) {
-    const double gz = gap(z, centre.z, 2);
-    const double rz2 = r2 - gz * gz;
-    if (rz2 < 0) continue;
-    const double rz = std::sqrt(rz2);
-    const std::int64_t y0 = std::max<std::int64_t>(cell_coord(centre.y - rz, 1), 0);
-    const std::int64_t y1 = std::min<std::int64_t>(cell_coord(centre.y + rz, 1), dims_[1] - 1);
-    for (std::int64_t y = y0; y <= y1; ++y) {
-      const double gy = gap(y, centre.y, 1);
-      const double ry2 = rz2 - gy * gy;
-      if (ry2 < 0) continue;
-      const double ry = std::sqrt(ry2);
-      const std::int64_t x0 = std::max<std::int64_t>(cell_coord(centre.x - ry, 0), 0);
-      const std::int64_t x1 = std::min<std::int64_t>(cell_coord(centre.x + ry, 0), dims_[0] - 1);
-      for (std::int64_t x = x0; x <= x1; ++x) {
-        const Slot* cell =
-            find_cell(morton3(static_cast<std::uint64_t>(x), static_cast<std::uint64_t>(y),
-                              static_cast<std::uint64_t>(z)));
-        if (!cell) continue;
-        for (std::uint32_t i = cell->begin, end = cell->end; i < end; ++i) {
-          const Vec3f& p = points_[i];
-          const double dx = p.x - centre.x, dy = p.y - centre.y, dz = p.z - centre.z;
-          const double d2 = dx * dx + dy * dy + dz * dz;
-          if (d2 <= r2) visit(i, d2);
+  static constexpr auto kSlabs = [] {
+    std::array<std::array<std::array<std::uint64_t, 4>, 4>, 3> slabs{};
+    for (int a = 0; a < 3; ++a) {
+      for (int l = 0; l < 4; ++l) {
+        for (int h = l; h < 4; ++h) slabs[a][l][h] = block_slab(a, l, h);
+      }
+    }
+    return slabs;
+  }();
+  // The block's cells in the query's box along one axis.
+  const auto slab = [&](int a, std::int64_t block) {
+    const std::int64_t first = 4 * block;
+    return kSlabs[a][std::max<std::int64_t>(lo[a] - first, 0)]
+                 [std::min<std::int64_t>(hi[a] - first, 3)];
+  };
+  // Points found are buffered and visited after the scan: the inside test then has no
+  // unpredictable branch (it decides only whether the buffer slot is kept).
+  std::uint32_t found[64];
+  double found_d2[64];
+  std::size_t count = 0;
+  const auto flush = [&] {
+    for (std::size_t f = 0; f < count; ++f) visit(found[f], found_d2[f]);
+    count = 0;
+  };
+  // Block by block, the non-empty cells in the query's box come from the masks at once; cells
+  // consecutive in Morton order have consecutive points, so each run of them is one range.
+  for (std::int64_t bz = lo[2] >> 2; bz <= hi[2] >> 2; ++bz) {
+    const std::uint64_t mask_z = slab(2, bz);
+    for (std::int64_t by = lo[1] >> 2; by <= hi[1] >> 2; ++by) {
+      const std::uint64_t mask_yz = mask_z & slab(1, by);
+      for (std::int64_t bx = lo[0] >> 2; bx <= hi[0] >> 2; ++bx) {
+        const Block* block =
+            find_block(morton3(static_cast<std::uint64_t>(bx), static_cast<std::uint64_t>(by),
+                               static_cast<std::uint64_t>(bz)));
+        if (!block) continue;
+        std::uint64_t cells = block->cells & mask_yz & slab(0, bx);
+        while (cells) {
+          const int start = std::countr_zero(cells);
+          const int run = std::countr_one(cells >> start);
+          const std::size_t k =
+              block->first + bit_count(block->cells & ((std::uint64_t{1} << start) - 1));
+          cells = start + run >= 64 ? 0 : cells & (~0ull << (start + run));
+          for (std::uint32_t i = cell_begin_[k],
+                             end = cell_begin_[k + static_cast<std::size_t>(run)];
+               i < end; ++i) {
+            const Vec3f& p = points_[i];
+            const double dx = p.x - centre.x, dy = p.y - centre.y, dz = p.z - centre.z;
+            const double d2 = dx * dx + dy * dy + dz * dz;
+            found[count] = i;
+            found_d2[count] = d2;
+            count += d2 <= r2;
+            if (count == std::size(found)) flush();
+          }
         }
       }
     }
   }
+  flush();
 }
 
 template <class Keep>
