@@ -9,7 +9,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <regex>
 #include <sstream>
 #include <string>
 
@@ -56,11 +55,12 @@ class PipelineMemory : public ::testing::Test {
     return text.str();
   }
 
+  // The number after "key": in a JSON object, or -1.
   static double number(const std::string& json, const std::string& key) {
-    const std::regex pattern("\"" + key + "\":\\s*([0-9.eE+-]+)");
-    std::smatch match;
-    if (!std::regex_search(json, match, pattern)) return -1;
-    return std::stod(match[1].str());
+    const std::string quoted = "\"" + key + "\":";
+    const std::size_t at = json.find(quoted);
+    if (at == std::string::npos) return -1;
+    return std::strtod(json.c_str() + at + quoted.size(), nullptr);  // skips the blanks
   }
 
   TempFolder dir_;
