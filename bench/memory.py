@@ -24,14 +24,8 @@ import tempfile
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
-
-
-def count(text):
-    match = re.fullmatch(r"([0-9]*\.?[0-9]+)([kKmMgG]?)", text.strip())
-    if not match:
-        raise argparse.ArgumentTypeError(f"expected a count like 10M, not '{text}'")
-    scale = {"": 1, "k": 10**3, "m": 10**6, "g": 10**9}[match.group(2).lower()]
-    return int(round(float(match.group(1)) * scale))
+sys.path.insert(0, str(REPO / "bench"))
+from run import count  # noqa: E402  (the same '10M'-style counts as bench/run.py)
 
 
 def run_timed(command):

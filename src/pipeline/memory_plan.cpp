@@ -2,8 +2,10 @@
 // thread growing a tile (its points, halo, hash grid, front and triangles), each tile grown and
 // waiting for the stitcher (its points and kept triangles), and the stitcher taking in a tile
 // (a live slot per point until the tile's interior is released). What does not: the band of
-// open seams, a few tens of spacings wide, small next to any tile. Bytes per point measured
-// with /usr/bin/time -v on the synthetic torus (docs/pipeline.md, "Memory").
+// open seams, a few tens of spacings wide, small next to any tile. The split below is an
+// estimate: what was measured (/usr/bin/time -v) is a whole single-thread run of one 450k-point
+// tile, 120 MB (about 270 bytes a point), and the resulting peaks, 262-286 MB for tori of 10M
+// and 40M points under 512M (docs/benchmarks.md, "Memory"): the constants are conservative.
 #include <fmt/core.h>
 #include <tbb/info.h>
 #include <unistd.h>
