@@ -3,15 +3,60 @@
 // with every corner in the tile) are the ones the whole cloud would give there; triangles that
 // reach into the halo are left to the seam stitcher. No triangle is kept by two tiles: its
 // corners lie in one tile only.
+//
+// Points deeper inside the box than any seam reaches have their whole star here, so their
+// non-manifold fans are cleaned here, in parallel, rather than by the serial stitcher; the
+// points a deletion may split nearer the border go on to the stitcher as suspects.
 #include <algorithm>
 #include <chrono>
 
+#include "cleanup/cleanup.hpp"
 #include "g2s/pipeline.hpp"
 #include "grid/hash_grid.hpp"
 #include "grow/grower.hpp"
 #include "pipeline/tile_geometry.hpp"
 
 namespace g2s {
+namespace {
+
+// Judges the fans of the suspects deeper than `depth` (see above) and deletes the triangles of
+// all but one fan; the suspects left, and those a deletion may have split, stay in second_fans.
+// out.second_fans[0, halo_corners) are corners of triangles left out at the halo.
+void clean_deep_fans(TileGrowth& out, const TileBox& box, double depth, std::size_t halo_corners) {
+  const std::size_t n = out.points.size();
+  std::vector<std::uint8_t> deep(n, 0);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double* p = &out.points.xyz[3 * k];
+    double inside = depth + 1;
+    for (int a = 0; a < 3; ++a) inside = std::min({inside, p[a] - box.lo[a], box.hi[a] - p[a]});
+    deep[k] = inside > depth;
+  }
+  for (std::size_t k = 0; k < halo_corners; ++k) deep[out.second_fans[k]] = 0;
+  std::vector<Index> judged, left;
+  for (Index v : out.second_fans) (deep[v] ? judged : left).push_back(v);
+  if (judged.empty()) return;
+  std::vector<std::uint8_t> dead;
+  const NonManifoldReport nm = mark_non_manifold_fans(out.triangles, n, judged, deep, dead, left);
+  out.report.triangles_removed = nm.triangles_removed;
+  out.report.non_manifold_vertices_fixed = nm.vertices_fixed;
+  // Groups renumbered densely again, in order of first kept triangle: none is left empty.
+  std::vector<std::uint32_t> dense(out.groups, kNoIndex);
+  out.groups = 0;
+  std::size_t kept = 0;
+  for (std::size_t t = 0; t < out.triangles.size(); ++t) {
+    if (dead[t]) continue;
+    std::uint32_t& group = dense[out.group[t]];
+    if (group == kNoIndex) group = out.groups++;
+    out.triangles[kept] = out.triangles[t];
+    out.group[kept] = group;
+    ++kept;
+  }
+  out.triangles.resize(kept);
+  out.group.resize(kept);
+  out.second_fans = std::move(left);
+}
+
+}  // namespace
 
 TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineOptions& options) {
   const auto start = std::chrono::steady_clock::now();
@@ -85,10 +130,13 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
     out.triangles.push_back({point_of[tri[0]], point_of[tri[1]], point_of[tri[2]]});
     out.group.push_back(group);
   }
+  // Corners of triangles left out at the halo are near the border: never judged here.
+  const std::size_t halo_corners = out.second_fans.size();
   for (Index v : grown.second_fans) {
     if (mine(v)) out.second_fans.push_back(point_of[v]);
   }
   out.report.triangles_grown = out.triangles.size();
+  clean_deep_fans(out, box, seam_depth(tiles, tile, options), halo_corners);
   out.report.seconds_grow =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - grow_start).count();
   return out;

@@ -1,5 +1,5 @@
 // Box geometry shared by the pipeline's stages: distances between points and tile boxes, the
-// tiles near a tile, and the local float frame a tile is meshed in.
+// tiles near a tile, the local float frame a tile is meshed in, and how far a seam reaches.
 #pragma once
 
 #include <algorithm>
@@ -7,6 +7,7 @@
 #include <span>
 #include <vector>
 
+#include "g2s/pipeline.hpp"
 #include "g2s/tile_store.hpp"
 
 namespace g2s {
@@ -67,6 +68,48 @@ inline double local_spacing(std::span<const TileInfo> tiles, std::size_t tile,
   double s = tiles[tile].spacing;
   for (std::size_t j : near) s = std::max(s, tiles[j].spacing);
   return s;
+}
+
+// Seam widths at a tile, in the largest spacing around it (local_spacing): the band grown, the
+// context loaded around it, and how far from the tile's box a triangle made at its seam can
+// reach (a band point, or a corner of a live triangle touching one: an edge is at most about
+// a search ball of max_radius spacings, and a longer one is caught: the triangle is dropped
+// and counted).
+struct SeamReach {
+  double band = 0;
+  double context = 0;
+  double touch = 0;
+  double margin = 0;  // the release margin beyond `touch`: the longest edge (two search balls)
+};
+
+inline SeamReach seam_reach(std::span<const TileInfo> tiles, std::size_t tile,
+                            const PipelineOptions& options) {
+  const double first = 2 * options.band_spacings * tiles[tile].spacing;
+  const double spacing = local_spacing(tiles, tile, tiles_near(tiles, tile, first));
+  SeamReach r;
+  r.band = options.band_spacings * spacing;
+  r.context = 2 * r.band;
+  r.touch = std::max(r.context, r.band + options.mesh.max_radius * spacing);
+  r.margin = 2 * options.mesh.max_radius * spacing;
+  return r;
+}
+
+// How deep inside its box a point of `tile` must lie for no seam to reach it: the largest
+// `touch` among the tile's own seam and those of the tiles whose seams reach into its box.
+inline double seam_depth(std::span<const TileInfo> tiles, std::size_t tile,
+                         const PipelineOptions& options) {
+  double largest_spacing = 0;
+  for (const TileInfo& t : tiles) largest_spacing = std::max(largest_spacing, t.spacing);
+  // No tile's touch exceeds this (its local spacing is at most the largest).
+  const double bound =
+      std::max(2 * options.band_spacings, options.band_spacings + options.mesh.max_radius) *
+      largest_spacing;
+  double depth = seam_reach(tiles, tile, options).touch;
+  for (std::size_t j : tiles_near(tiles, tile, bound)) {
+    const double touch = seam_reach(tiles, j, options).touch;
+    if (box_gap(tiles[tile].box, tiles[j].box) <= touch) depth = std::max(depth, touch);
+  }
+  return depth;
 }
 
 }  // namespace g2s

@@ -34,30 +34,6 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// Seam widths at a tile, in the largest spacing around it (local_spacing): the band grown, the
-// context loaded around it, and how far from the tile's box a triangle made at its seam can
-// reach (a band point, or a corner of a live triangle touching one: an edge is at most about
-// a search ball of max_radius spacings, and a longer one is caught: the triangle is dropped
-// and counted).
-struct SeamReach {
-  double band = 0;
-  double context = 0;
-  double touch = 0;
-  double margin = 0;  // the release margin beyond `touch`: the longest edge (two search balls)
-};
-
-SeamReach seam_reach(std::span<const TileInfo> tiles, std::size_t tile,
-                     const PipelineOptions& options) {
-  const double first = 2 * options.band_spacings * tiles[tile].spacing;
-  const double spacing = local_spacing(tiles, tile, tiles_near(tiles, tile, first));
-  SeamReach r;
-  r.band = options.band_spacings * spacing;
-  r.context = 2 * r.band;
-  r.touch = std::max(r.context, r.band + options.mesh.max_radius * spacing);
-  r.margin = 2 * options.mesh.max_radius * spacing;
-  return r;
-}
-
 class SeamStitcher {
  public:
   SeamStitcher(const TileSource& source, const PipelineOptions& options)
@@ -333,7 +309,9 @@ void Stitcher::add(std::size_t tile, TileGrowth growth) {
   r.duplicates_merged += growth.report.duplicates_merged;
   r.seconds_grid += growth.report.seconds_grid;
   r.seconds_grow += growth.report.seconds_grow;
-  r.triangles_grown += growth.triangles.size();
+  r.triangles_grown += growth.triangles.size() + growth.report.triangles_removed;
+  r.triangles_removed += growth.report.triangles_removed;
+  r.non_manifold_vertices_fixed += growth.report.non_manifold_vertices_fixed;
   r.spacing = std::max(r.spacing, growth.report.spacing);
   growth = TileGrowth{};
   const auto [added, dropped] = m.stitcher.stitch(tile, m.reach[tile], live);
@@ -356,8 +334,8 @@ PipelineSummary Stitcher::finish() {
   out.triangles = m.released.triangles;
   out.vertices = m.released.vertices;
   out.peak_live_points = m.live.peak_points;
-  out.report.triangles_removed = m.released.non_manifold.triangles_removed;
-  out.report.non_manifold_vertices_fixed = m.released.non_manifold.vertices_fixed;
+  out.report.triangles_removed += m.released.non_manifold.triangles_removed;
+  out.report.non_manifold_vertices_fixed += m.released.non_manifold.vertices_fixed;
   out.vertices_unjudged = m.released.non_manifold.vertices_unjudged;
   const std::vector<std::uint8_t> flip =
       group_flips(m.live.groups, m.live.sums, m.options.mesh.orient, out.report.components_flipped);
