@@ -90,6 +90,10 @@ class AtomicFile {
   void write(const void* data, std::size_t bytes);                           // buffered
   void write_at(std::uint64_t offset, const void* data, std::size_t bytes);  // patch written bytes
   std::uint64_t size() const;                                                // bytes written so far
+  // Hands the buffer to the OS. After it, until the next write(), read_at and write_at touch
+  // only the file and may run from several threads at once on disjoint ranges.
+  void flush();
+  void read_at(std::uint64_t offset, void* data, std::size_t bytes) const;  // flushed bytes only
   void commit();
   const std::filesystem::path& target() const { return target_; }
   const std::filesystem::path& temporary() const { return temporary_; }
@@ -134,8 +138,10 @@ void write_mesh(const std::filesystem::path& target, std::span<const double> xyz
 // The tiled pipeline's writer: a MeshSink that spills triangles to a temporary beside the target
 // as they come, and at finish() writes the target in `format` with the groups' flips applied,
 // atomically (as write_mesh would: PLY indexed, float unless a coordinate would not survive).
-// Disk: the spill (40 bytes a triangle for STL; 16 a triangle and 24 a vertex for PLY) and the
-// output exist together at the end. With no triangle, or destroyed unfinished, it leaves no file.
+// Disk: binary STL is written in place as triangles come, with 8 bytes per run of one group
+// beside it; ASCII STL spills 40 bytes a triangle, PLY 16 a triangle and 24 a vertex, and the
+// spill and the output exist together at the end. With no triangle, or destroyed unfinished, it
+// leaves no file.
 class MeshStreamWriter final : public MeshSink {
  public:
   MeshStreamWriter(const std::filesystem::path& target, MeshFormat format);

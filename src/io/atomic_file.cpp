@@ -41,7 +41,7 @@ AtomicFile::AtomicFile(const std::filesystem::path& target) : target_(target) {
                fmt::format(".{}.tmp-{}-{}", name, static_cast<long>(::getpid()), g_counter++);
   // Registered before it exists, so a signal arriving just after it appears still removes it.
   registry_slot_ = register_temporary(temporary_.c_str());
-  fd_ = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  fd_ = ::open(temporary_.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
   if (fd_ < 0) {
     const int err = errno;
     unregister_temporary(registry_slot_);
@@ -119,6 +119,30 @@ void AtomicFile::write_at(std::uint64_t offset, const void* data, std::size_t by
   }
   // The part still in the buffer.
   if (bytes > 0) std::memcpy(buffer_.data() + (offset - written_), p, bytes);
+}
+
+void AtomicFile::flush() {
+  if (fd_ < 0) fail_write(target_, "write after commit", EBADF);
+  flush_buffer();
+}
+
+void AtomicFile::read_at(std::uint64_t offset, void* data, std::size_t bytes) const {
+  if (fd_ < 0 || offset > written_ || bytes > written_ - offset) {
+    throw Error(Exit::failure, fmt::format("{}: read_at({}, {} bytes) beyond the {} bytes flushed",
+                                           target_.string(), offset, bytes, written_));
+  }
+  char* p = static_cast<char*>(data);
+  while (bytes > 0) {
+    const ssize_t n = ::pread(fd_, p, bytes, static_cast<off_t>(offset));
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      fail_write(target_, "cannot read back", errno);
+    }
+    if (n == 0) fail_write(target_, "cannot read back", EIO);
+    p += n;
+    bytes -= static_cast<std::size_t>(n);
+    offset += static_cast<std::uint64_t>(n);
+  }
 }
 
 std::uint64_t AtomicFile::size() const {

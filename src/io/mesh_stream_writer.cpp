@@ -1,18 +1,27 @@
 // MeshStreamWriter: the tiled pipeline's output stage. Triangles arrive as the stitcher finishes
-// them but their orientation is known only at the end, so they go first to a spill file beside
-// the target (a temporary, removed however the run ends), then one sequential pass writes the
-// real file with each group's flip applied. Memory stays a pair of buffers whatever the mesh.
+// them but their orientation is known only at the end.
+// - Binary STL: each facet goes straight into the target's temporary as it comes, facing as its
+//   group does so far, and the runs of one group go to a small spill file; at the end only the
+//   facets of flipped groups are rewritten in place, window by window in parallel.
+// - ASCII STL and PLY (variable-length text; vertices before faces): triangles go to a spill file
+//   beside the target, then one sequential pass writes the real file with each group's flip
+//   applied.
+// The spills are temporaries, removed however the run ends. Memory stays a few buffers whatever
+// the mesh.
 #include <fcntl.h>
 #include <fmt/core.h>
+#include <tbb/parallel_for.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
 #include "io/le_bytes.hpp"
+#include "io/stl_record.hpp"
 
 namespace g2s {
 namespace {
@@ -91,23 +100,115 @@ bool survives_float(double v) {
   return static_cast<double>(static_cast<float>(v)) == v;
 }
 
+// Facets of a binary STL read, flipped where needed and written back at a time (800 KB), and
+// windows gathered before they are rewritten in parallel.
+constexpr std::uint64_t kWindowFacets = 1u << 14;
+constexpr std::uint64_t kBatchWindows = 16;
+
+// Rewrites the facets of `ranges` ([lo, hi), sorted) that lie in the window starting at facet
+// `window` of a flushed binary STL with corners b and c swapped, as if written flipped.
+void flip_facets(AtomicFile& stl, std::span<const std::array<std::uint64_t, 2>> ranges,
+                 std::uint64_t window) {
+  std::vector<char> bytes;
+  for (const auto& [lo, hi] : ranges) {
+    const std::uint64_t first = std::max(lo, window), last = std::min(hi, window + kWindowFacets);
+    if (first >= last) continue;
+    bytes.resize((last - first) * kStlRecordBytes);
+    const std::uint64_t offset = kStlHeaderBytes + first * kStlRecordBytes;
+    stl.read_at(offset, bytes.data(), bytes.size());
+    for (std::size_t r = 0; r < bytes.size(); r += kStlRecordBytes) {
+      float f[9];
+      std::memcpy(f, bytes.data() + r + 12, sizeof f);
+      double c[9];
+      for (int k = 0; k < 9; ++k) c[k] = f[k];
+      stl_record(c, c + 6, c + 3, bytes.data() + r);
+    }
+    stl.write_at(offset, bytes.data(), bytes.size());
+  }
+}
+
 }  // namespace
 
 struct MeshStreamWriter::Impl {
-  Impl(const std::filesystem::path& t, MeshFormat f)
-      : target(t), format(f), triangles(t, "triangles") {
+  Impl(const std::filesystem::path& t, MeshFormat f) : target(t), format(f) {
+    if (format == MeshFormat::stl_binary) {
+      stl = std::make_unique<AtomicFile>(t);
+      char header[kStlHeaderBytes] = {};
+      const char text[] = "binary STL written by g2s";
+      std::memcpy(header, text, sizeof text - 1);
+      std::memset(header + sizeof text - 1, ' ', 80 - (sizeof text - 1));
+      stl->write(header, sizeof header);  // the count (bytes 80..83) is patched by finish()
+      runs = std::make_unique<SpillFile>(t, "groups");
+      return;
+    }
+    triangles = std::make_unique<SpillFile>(t, "triangles");
     if (format == MeshFormat::ply_binary) vertices = std::make_unique<SpillFile>(t, "vertices");
+  }
+  template <typename Flipped>
+  void finish_binary_stl(const Flipped& flipped);
+  void end_run() {
+    if (run_count == 0) return;
+    const std::uint32_t record[2] = {run_group, run_count};
+    runs->append(record, sizeof record);
+    run_count = 0;
   }
   std::filesystem::path target;
   MeshFormat format;
-  SpillFile triangles;                  // STL: group, 9 floats; PLY: group, 3 vertex numbers
-  std::unique_ptr<SpillFile> vertices;  // PLY: 3 doubles per vertex
+  std::unique_ptr<AtomicFile> stl;  // binary STL: the target, facets as they come
+  std::unique_ptr<SpillFile> runs;  // binary STL: (group, facets) per run of one group
+  std::uint32_t run_group = 0;
+  std::uint32_t run_count = 0;
+  std::unique_ptr<SpillFile> triangles;  // ASCII STL: group, 9 floats; PLY: group, 3 numbers
+  std::unique_ptr<SpillFile> vertices;   // PLY: 3 doubles per vertex
   std::uint64_t vertex_count = 0;
   std::uint64_t triangle_count = 0;
   bool as_float = true;
   double largest = 0.0;
   double worst = 0.0;
 };
+
+// The facets of flipped groups, gathered from the runs a batch of windows at a time; each window
+// is read, flipped and written back by one task.
+template <typename Flipped>
+void MeshStreamWriter::Impl::finish_binary_stl(const Flipped& flipped) {
+  end_run();
+  stl->flush();
+  std::vector<std::array<std::uint64_t, 2>> ranges;  // flipped facets [lo, hi) in the batch
+  std::uint64_t batch = 0;                           // first facet of the batch
+  constexpr std::uint64_t kBatchFacets = kBatchWindows * kWindowFacets;
+  auto rewrite_batch = [&] {
+    if (!ranges.empty()) {
+      tbb::parallel_for(std::uint64_t{0}, kBatchWindows, [&](std::uint64_t w) {
+        flip_facets(*stl, ranges, batch + w * kWindowFacets);
+      });
+    }
+    ranges.clear();
+    batch += kBatchFacets;
+  };
+  std::uint64_t facet = 0;
+  runs->read_back(8, [&](const char* record) {
+    std::uint32_t run[2];
+    std::memcpy(run, record, sizeof run);
+    std::uint64_t lo = facet;
+    facet += run[1];
+    if (!flipped(run[0])) return;
+    while (lo < facet) {
+      while (lo >= batch + kBatchFacets) rewrite_batch();
+      const std::uint64_t hi = std::min(facet, batch + kBatchFacets);
+      if (!ranges.empty() && ranges.back()[1] == lo) {
+        ranges.back()[1] = hi;
+      } else {
+        ranges.push_back({lo, hi});
+      }
+      lo = hi;
+    }
+  });
+  rewrite_batch();
+  char count[4];
+  io::put_le(count, static_cast<std::uint32_t>(triangle_count));
+  stl->write_at(80, count, sizeof count);
+  stl->commit();
+}
 
 MeshStreamWriter::MeshStreamWriter(const std::filesystem::path& target, MeshFormat format)
     : impl_(std::make_unique<Impl>(target, format)) {}
@@ -128,10 +229,25 @@ void MeshStreamWriter::vertex(Index, const double xyz[3]) {
 void MeshStreamWriter::triangle(const Triangle& corners, const std::array<const double*, 3>& xyz,
                                 std::uint32_t group) {
   Impl& m = *impl_;
+  if (m.format == MeshFormat::stl_binary) {
+    if (m.triangle_count >= std::numeric_limits<std::uint32_t>::max()) {
+      throw Error(Exit::write_failed,
+                  fmt::format("{}: more than {} triangles do not fit in a binary STL",
+                              m.target.string(), std::numeric_limits<std::uint32_t>::max()));
+    }
+    char record[kStlRecordBytes];
+    stl_record(xyz[0], xyz[1], xyz[2], record);
+    m.stl->write(record, sizeof record);
+    if (m.run_count > 0 && m.run_group != group) m.end_run();
+    m.run_group = group;
+    ++m.run_count;
+    ++m.triangle_count;
+    return;
+  }
   ++m.triangle_count;
   if (m.format == MeshFormat::ply_binary) {
     const std::uint32_t record[4] = {group, corners[0], corners[1], corners[2]};
-    m.triangles.append(record, sizeof record);
+    m.triangles->append(record, sizeof record);
     return;
   }
   struct {
@@ -141,7 +257,7 @@ void MeshStreamWriter::triangle(const Triangle& corners, const std::array<const 
   for (int c = 0; c < 3; ++c) {
     for (int k = 0; k < 3; ++k) record.xyz[3 * c + k] = static_cast<float>(xyz[c][k]);
   }
-  m.triangles.append(&record, sizeof record);
+  m.triangles->append(&record, sizeof record);
 }
 
 void MeshStreamWriter::finish(std::span<const std::uint8_t> flip) {
@@ -151,9 +267,13 @@ void MeshStreamWriter::finish(std::span<const std::uint8_t> flip) {
     if (group >= flip.size()) throw Error(Exit::failure, "mesh writer: unknown orientation group");
     return flip[group] != 0;
   };
-  if (m.format != MeshFormat::ply_binary) {
-    StlWriter writer(m.target, m.format == MeshFormat::stl_ascii);
-    m.triangles.read_back(40, [&](const char* record) {
+  if (m.format == MeshFormat::stl_binary) {
+    m.finish_binary_stl(flipped);
+    return;
+  }
+  if (m.format == MeshFormat::stl_ascii) {
+    StlWriter writer(m.target, true);
+    m.triangles->read_back(40, [&](const char* record) {
       std::uint32_t group = 0;
       float f[9];
       std::memcpy(&group, record, 4);
@@ -187,7 +307,7 @@ void MeshStreamWriter::finish(std::span<const std::uint8_t> flip) {
     }
     file.write(out, static_cast<std::size_t>(p - out));
   });
-  m.triangles.read_back(16, [&](const char* record) {
+  m.triangles->read_back(16, [&](const char* record) {
     std::uint32_t r[4];
     std::memcpy(r, record, sizeof r);
     if (flipped(r[0])) std::swap(r[2], r[3]);

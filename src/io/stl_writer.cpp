@@ -10,17 +10,15 @@
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
 #include "io/le_bytes.hpp"
+#include "io/stl_record.hpp"
 
 namespace g2s {
 namespace {
 
-void facet(const double a[3], const double b[3], const double c[3], float corners[9],
-           float normal[3]) {
-  for (int k = 0; k < 3; ++k) {
-    corners[k] = static_cast<float>(a[k]);
-    corners[3 + k] = static_cast<float>(b[k]);
-    corners[6 + k] = static_cast<float>(c[k]);
-  }
+// The normal from the float corners alone. Not inlined: GCC 12's SLP vectoriser at -O3 would
+// otherwise subtract the double coordinates the corners were rounded from, so that a facet
+// rewritten later from its stored floats (MeshStreamWriter's flips) would get another normal.
+[[gnu::noinline]] void facet_normal(const float corners[9], float normal[3]) {
   double u[3];
   double v[3];
   for (int k = 0; k < 3; ++k) {
@@ -35,7 +33,27 @@ void facet(const double a[3], const double b[3], const double c[3], float corner
   }
 }
 
+void facet(const double a[3], const double b[3], const double c[3], float corners[9],
+           float normal[3]) {
+  for (int k = 0; k < 3; ++k) {
+    corners[k] = static_cast<float>(a[k]);
+    corners[3 + k] = static_cast<float>(b[k]);
+    corners[6 + k] = static_cast<float>(c[k]);
+  }
+  facet_normal(corners, normal);
+}
+
 }  // namespace
+
+void stl_record(const double a[3], const double b[3], const double c[3], char record[50]) {
+  float corners[9];
+  float normal[3];
+  facet(a, b, c, corners, normal);
+  char* p = record;
+  for (float f : normal) p = io::put_le(p, f);
+  for (float f : corners) p = io::put_le(p, f);
+  io::put_le(p, std::uint16_t{0});
+}
 
 StlWriter::StlWriter(const std::filesystem::path& target, bool ascii)
     : file_(target), ascii_(ascii) {
@@ -51,10 +69,10 @@ StlWriter::StlWriter(const std::filesystem::path& target, bool ascii)
 }
 
 void StlWriter::add(const double a[3], const double b[3], const double c[3]) {
-  float corners[9];
-  float normal[3];
-  facet(a, b, c, corners, normal);
   if (ascii_) {
+    float corners[9];
+    float normal[3];
+    facet(a, b, c, corners, normal);
     fmt::memory_buffer out;
     fmt::format_to(std::back_inserter(out),
                    "facet normal {} {} {}\n  outer loop\n    vertex {} {} {}\n    vertex {} {} {}\n"
@@ -69,10 +87,7 @@ void StlWriter::add(const double a[3], const double b[3], const double c[3]) {
                               file_.target().string(), std::numeric_limits<std::uint32_t>::max()));
     }
     char record[50];
-    char* p = record;
-    for (float f : normal) p = io::put_le(p, f);
-    for (float f : corners) p = io::put_le(p, f);
-    io::put_le(p, std::uint16_t{0});
+    stl_record(a, b, c, record);
     file_.write(record, sizeof record);
   }
   ++count_;

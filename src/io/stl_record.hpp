@@ -1,0 +1,16 @@
+// One binary STL facet record, shared by the streaming writers so that a facet written directly
+// and one rewritten later (flipped in place) come out byte for byte the same.
+#pragma once
+
+#include <cstddef>
+
+namespace g2s {
+
+inline constexpr std::size_t kStlHeaderBytes = 84;  // 80-byte header and the triangle count
+inline constexpr std::size_t kStlRecordBytes = 50;
+
+// Triangle (a, b, c) as 50 bytes: the normal (normalised cross product of the float corners;
+// zero for a degenerate facet), the corners as float, a zero attribute.
+void stl_record(const double a[3], const double b[3], const double c[3], char record[50]);
+
+}  // namespace g2s
