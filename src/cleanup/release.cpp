@@ -52,16 +52,16 @@ void release_finished(LiveMesh& live, std::size_t step, const Vec3& origin, Mesh
   }
   std::size_t kept = 0;
   for (std::size_t t = 0; t < live.triangles.size(); ++t) {
-    const Triangle tri = live.triangles[t];
     const bool removed = !dead.empty() && dead[t];
-    const bool released =
-        (live.flags[tri[0]] & live.flags[tri[1]] & live.flags[tri[2]] & LiveMesh::kReleased) != 0;
+    const bool released = live.due[t] <= step;
     if (!removed && !released) {
-      live.triangles[kept] = tri;
+      live.triangles[kept] = live.triangles[t];
       live.group[kept] = live.group[t];
+      live.due[kept] = live.due[t];
       ++kept;
       continue;
     }
+    const Triangle tri = live.triangles[t];
     if (!removed) {
       Triangle numbers{};
       for (int k = 0; k < 3; ++k) {
@@ -87,6 +87,7 @@ void release_finished(LiveMesh& live, std::size_t step, const Vec3& origin, Mesh
   }
   live.triangles.resize(kept);
   live.group.resize(kept);
+  live.due.resize(kept);
   for (std::uint32_t s : maybe_free) {
     if ((live.flags[s] & LiveMesh::kReleased) && live.uses[s] == 0) live.free_slot(s);
   }

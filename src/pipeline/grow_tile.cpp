@@ -25,12 +25,7 @@ namespace {
 void clean_deep_fans(TileGrowth& out, const TileBox& box, double depth, std::size_t halo_corners) {
   const std::size_t n = out.points.size();
   std::vector<std::uint8_t> deep(n, 0);
-  for (std::size_t k = 0; k < n; ++k) {
-    const double* p = &out.points.xyz[3 * k];
-    double inside = depth + 1;
-    for (int a = 0; a < 3; ++a) inside = std::min({inside, p[a] - box.lo[a], box.hi[a] - p[a]});
-    deep[k] = inside > depth;
-  }
+  for (std::size_t k = 0; k < n; ++k) deep[k] = box_depth(box, &out.points.xyz[3 * k]) > depth;
   for (std::size_t k = 0; k < halo_corners; ++k) deep[out.second_fans[k]] = 0;
   std::vector<Index> judged, left;
   for (Index v : out.second_fans) (deep[v] ? judged : left).push_back(v);

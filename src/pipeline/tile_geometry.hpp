@@ -30,6 +30,13 @@ inline double box_gap(const TileBox& a, const TileBox& b) {
   return std::sqrt(d2);
 }
 
+// How far inside the box p lies: its distance to the nearest face (negative outside).
+inline double box_depth(const TileBox& box, const double* p) {
+  double depth = box.hi[0] - p[0];
+  for (int a = 0; a < 3; ++a) depth = std::min({depth, p[a] - box.lo[a], box.hi[a] - p[a]});
+  return depth;
+}
+
 inline bool box_contains(const TileBox& box, const double* p) {
   for (int a = 0; a < 3; ++a) {
     if (p[a] < box.lo[a] || p[a] > box.hi[a]) return false;

@@ -10,6 +10,7 @@
 // them and so split its fan, which must then be judged again on its whole star.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -26,6 +27,7 @@ struct LiveMesh {
   static constexpr std::uint8_t kSuspect = 2;  // may have more than one fan
   static constexpr std::uint8_t kInBand = 4;   // scratch of the seam being stitched
   static constexpr std::uint8_t kReleased = 8;
+  static constexpr std::uint8_t kUnlisted = 16;  // not in slot_of: no seam will look it up
 
   IdMap slot_of;  // global id -> slot
   std::vector<Index> id;
@@ -33,15 +35,20 @@ struct LiveMesh {
   std::vector<std::uint32_t> number;  // vertex number given to the sink; kNoIndex before
   std::vector<std::uint32_t> uses;    // live triangles with this corner
   std::vector<std::uint8_t> flags;
+  std::vector<std::uint32_t> release_step;  // the step after which the point is released
   std::vector<std::uint32_t> free_slots;
   std::vector<std::vector<std::uint32_t>> finishing;  // per step: the slots it finishes
   std::vector<std::vector<std::uint32_t>> releasing;  // per step: the slots it releases
 
   std::vector<Triangle> triangles;  // in slots
   std::vector<std::uint32_t> group;
+  // Per triangle: the step that releases its last corner, so that finding the triangles a step
+  // releases reads this array in order instead of three corners' flags each.
+  std::vector<std::uint32_t> due;
   ParityUnionFind groups;
   std::vector<GroupSums> sums;  // per group
 
+  std::size_t points = 0;  // live
   std::size_t peak_points = 0;
 
   explicit LiveMesh(std::size_t steps) : finishing(steps), releasing(steps) {}
@@ -49,9 +56,10 @@ struct LiveMesh {
   std::size_t capacity() const { return id.size(); }
 
   // A point of the tile being added, finished after step `finish` and released after `release`;
-  // returns its slot.
-  std::uint32_t add_point(Index point, const double* p, std::uint32_t finish,
-                          std::uint32_t release) {
+  // returns its slot. Only `listed` points can be found by id (slot()): the others lie where no
+  // seam reaches, and leaving them out of the hash map saves a cache miss per point.
+  std::uint32_t add_point(Index point, const double* p, std::uint32_t finish, std::uint32_t release,
+                          bool listed) {
     std::uint32_t s = 0;
     if (free_slots.empty()) {
       s = static_cast<std::uint32_t>(id.size());
@@ -60,6 +68,7 @@ struct LiveMesh {
       number.push_back(kNoIndex);
       uses.push_back(0);
       flags.push_back(0);
+      release_step.push_back(release);
     } else {
       s = free_slots.back();
       free_slots.pop_back();
@@ -68,13 +77,17 @@ struct LiveMesh {
       number[s] = kNoIndex;
       uses[s] = 0;
       flags[s] = 0;
+      release_step[s] = release;
     }
-    if (slot_of.insert(point, s) != s) {
+    if (!listed) {
+      flags[s] = kUnlisted;
+    } else if (slot_of.insert(point, s) != s) {
       throw Error(Exit::bad_input, "tile store: a point id appears in two tiles");
     }
     finishing[finish].push_back(s);
     releasing[release].push_back(s);
-    peak_points = std::max(peak_points, slot_of.size());
+    ++points;
+    peak_points = std::max(peak_points, points);
     return s;
   }
 
@@ -89,12 +102,15 @@ struct LiveMesh {
   void add_triangle(const Triangle& slots, std::uint32_t g) {
     triangles.push_back(slots);
     group.push_back(g);
+    due.push_back(
+        std::max({release_step[slots[0]], release_step[slots[1]], release_step[slots[2]]}));
     for (Index s : slots) ++uses[s];
   }
 
   // Forgets a released point no live triangle uses.
   void free_slot(std::uint32_t s) {
-    slot_of.erase(id[s]);
+    if (!(flags[s] & kUnlisted)) slot_of.erase(id[s]);
+    --points;
     flags[s] = 0;
     free_slots.push_back(s);
   }

@@ -224,9 +224,7 @@ struct Stitcher::Impl {
     const std::span<const TileInfo> tiles = source.tiles();
     const TileBox& box = tiles[tile].box;
     // Every other box lies outside this one: a point deeper inside than any reach is done.
-    double depth = inside + 1;
-    for (int a = 0; a < 3; ++a) depth = std::min({depth, p[a] - box.lo[a], box.hi[a] - p[a]});
-    if (depth > inside) return static_cast<std::uint32_t>(tile);
+    if (box_depth(box, p) > inside) return static_cast<std::uint32_t>(tile);
     for (std::size_t k = later.size(); k-- > 0;) {
       const SeamReach& r = reach[later[k]];
       if (box_distance(tiles[later[k]].box, p) <= r.touch + (margin ? r.margin : 0.0)) {
@@ -279,6 +277,9 @@ void Stitcher::add(std::size_t tile, TileGrowth growth) {
         inside = std::max(inside, far);
       }
     }
+    // Deeper than this, a point is out of reach of this tile's seams, even as the far corner of a
+    // live triangle touching the band (the longest edge: the margin).
+    const double unreachable = m.reach[tile].touch + m.reach[tile].margin;
     for (std::size_t k = 0; k < points.size(); ++k) {
       if (points.ids[k] >= m.source.point_count()) {
         throw Error(Exit::bad_input, "tile store: a point id is out of range");
@@ -287,7 +288,8 @@ void Stitcher::add(std::size_t tile, TileGrowth growth) {
       const std::uint32_t release = m.last_step(tile, p, later, inside, true);
       const std::uint32_t finish =
           release == tile ? release : m.last_step(tile, p, later, inside, false);
-      slot_of_point[k] = live.add_point(points.ids[k], p, finish, release);
+      const bool listed = release != tile || box_depth(tiles[tile].box, p) <= unreachable;
+      slot_of_point[k] = live.add_point(points.ids[k], p, finish, release, listed);
     }
   }
   const auto base = static_cast<std::uint32_t>(live.groups.size());
