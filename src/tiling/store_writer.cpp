@@ -324,6 +324,13 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
       ids[at] = static_cast<Index>(id);
     });
     check_unchanged(input, first, again);
+    // The spacing estimates of the round's tiles, in parallel (each is a serial pass over its
+    // tile); the blocks are then written one by one, each encoded in parallel.
+    std::vector<double> spacing(round_end - round_begin);
+    tbb::parallel_for(round_begin, round_end, [&](std::size_t t) {
+      spacing[t - round_begin] = estimate_tile_spacing(
+          std::span<const double>(xyz.data() + 3 * start[t], 3 * counts[leaves[t]]));
+    });
     for (std::size_t t = round_begin; t < round_end; ++t) {
       const std::uint32_t node = leaves[t];
       const std::size_t begin = start[t];
@@ -338,7 +345,7 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
         store_le(e + entry::box + 24 + 8 * a, tree.box(node).hi[a]);
       }
       store_le(e + entry::points, std::uint64_t{n});
-      store_le(e + entry::spacing, estimate_tile_spacing(tile_xyz));
+      store_le(e + entry::spacing, spacing[t - round_begin]);
       store_le(e + entry::block_offset, block.offset);
       store_le(e + entry::block_bytes, block.bytes);
       store_le(e + entry::frame_table_checksum, block.frame_table_checksum);
