@@ -40,7 +40,10 @@ class MemoryTiles final : public TileSource {
 // are given by their index among the tile's points as TileSource::load returns them (the
 // stitcher takes them in with no lookup by global id).
 struct TileGrowth {
-  std::vector<Triangle> triangles;   // indices into the tile's points
+  std::vector<Triangle> triangles;  // indices into the tile's points
+  // The first final_triangles triangles are final: every corner is out of reach of all seams
+  // and clean-ups to come, so the stitcher hands them to the output as they are.
+  std::size_t final_triangles = 0;
   std::vector<std::uint32_t> group;  // per triangle: orientation group, 0..groups-1
   std::uint32_t groups = 0;          // triangles of one group face consistently
   // Corners (indices into the tile's points) that may have more than one fan: where fronts met

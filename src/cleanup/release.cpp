@@ -22,6 +22,22 @@ void add_to_sums(GroupSums& s, const std::array<const double*, 3>& xyz, const Ve
 
 }  // namespace
 
+void emit_triangle(const std::array<std::uint32_t*, 3>& number,
+                   const std::array<const double*, 3>& xyz, const Triangle& ids, GroupSums& sums,
+                   std::uint32_t group, const Vec3& origin, MeshSink& sink, ReleaseCounts& counts) {
+  Triangle numbers{};
+  for (int k = 0; k < 3; ++k) {
+    if (*number[k] == kNoIndex) {
+      *number[k] = counts.vertices++;
+      sink.vertex(ids[k], xyz[k]);
+    }
+    numbers[k] = *number[k];
+  }
+  sink.triangle(numbers, xyz, group);
+  ++counts.triangles;
+  add_to_sums(sums, xyz, origin, ids);
+}
+
 void release_finished(LiveMesh& live, std::size_t step, const Vec3& origin, MeshSink& sink,
                       ReleaseCounts& counts) {
   // Taken out of the lists (not cleared in place, which would keep their capacity).
@@ -63,22 +79,11 @@ void release_finished(LiveMesh& live, std::size_t step, const Vec3& origin, Mesh
     }
     const Triangle tri = live.triangles[t];
     if (!removed) {
-      Triangle numbers{};
-      for (int k = 0; k < 3; ++k) {
-        const Index s = tri[k];
-        if (live.number[s] == kNoIndex) {
-          live.number[s] = counts.vertices++;
-          sink.vertex(live.id[s], &live.xyz[3 * std::size_t{s}]);
-        }
-        numbers[k] = live.number[s];
-      }
-      const std::array<const double*, 3> xyz{&live.xyz[3 * std::size_t{tri[0]}],
-                                             &live.xyz[3 * std::size_t{tri[1]}],
-                                             &live.xyz[3 * std::size_t{tri[2]}]};
-      sink.triangle(numbers, xyz, live.group[t]);
-      ++counts.triangles;
-      add_to_sums(live.sums[live.group[t]], xyz, origin,
-                  {live.id[tri[0]], live.id[tri[1]], live.id[tri[2]]});
+      emit_triangle({&live.number[tri[0]], &live.number[tri[1]], &live.number[tri[2]]},
+                    {&live.xyz[3 * std::size_t{tri[0]}], &live.xyz[3 * std::size_t{tri[1]}],
+                     &live.xyz[3 * std::size_t{tri[2]}]},
+                    {live.id[tri[0]], live.id[tri[1]], live.id[tri[2]]}, live.sums[live.group[t]],
+                    live.group[t], origin, sink, counts);
     }
     for (Index s : tri) {
       --live.uses[s];

@@ -6,7 +6,9 @@
 //
 // Points deeper inside the box than any seam reaches have their whole star here, so their
 // non-manifold fans are cleaned here, in parallel, rather than by the serial stitcher; the
-// points a deletion may split nearer the border go on to the stitcher as suspects.
+// points a deletion may split nearer the border go on to the stitcher as suspects. Triangles
+// deeper still, beyond the stitcher's release margin too, are final: they come first, counted,
+// and the stitcher passes them to the output without holding them.
 #include <algorithm>
 #include <chrono>
 
@@ -49,6 +51,30 @@ void clean_deep_fans(TileGrowth& out, const TileBox& box, double depth, std::siz
   out.triangles.resize(kept);
   out.group.resize(kept);
   out.second_fans = std::move(left);
+}
+
+// Moves the triangles whose corners all lie deeper than `depth` (out of reach of every seam and
+// of the clean-up's release margin: final already) to the front, in order, and counts them, so
+// that the stitcher hands them straight to the output.
+void put_final_first(TileGrowth& out, const TileBox& box, double depth) {
+  auto deep = [&](Index v) { return box_depth(box, &out.points.xyz[3 * std::size_t{v}]) > depth; };
+  std::vector<Triangle> rest;
+  std::vector<std::uint32_t> rest_group;
+  std::size_t final_count = 0;
+  for (std::size_t t = 0; t < out.triangles.size(); ++t) {
+    const Triangle tri = out.triangles[t];
+    if (deep(tri[0]) && deep(tri[1]) && deep(tri[2])) {
+      out.triangles[final_count] = tri;
+      out.group[final_count] = out.group[t];
+      ++final_count;
+    } else {
+      rest.push_back(tri);
+      rest_group.push_back(out.group[t]);
+    }
+  }
+  std::copy(rest.begin(), rest.end(), out.triangles.begin() + final_count);
+  std::copy(rest_group.begin(), rest_group.end(), out.group.begin() + final_count);
+  out.final_triangles = final_count;
 }
 
 }  // namespace
@@ -132,6 +158,7 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
   }
   out.report.triangles_grown = out.triangles.size();
   clean_deep_fans(out, box, seam_depth(tiles, tile, options), halo_corners);
+  put_final_first(out, box, seam_depth(tiles, tile, options, true));
   out.report.seconds_grow =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - grow_start).count();
   return out;

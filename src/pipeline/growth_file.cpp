@@ -19,12 +19,13 @@ namespace g2s {
 namespace {
 
 constexpr char kMagic[8] = {'G', '2', 'S', 'G', 'R', 'O', 'W', '\0'};
-// 2: corners as indices into the tile's points; 3: the tile's own non-manifold clean-up counts.
+// 2: corners as indices into the tile's points; 3: the tile's own non-manifold clean-up counts
+// and its final triangles.
 constexpr std::uint32_t kVersion = 3;
 // magic, version, tile, fingerprint, triangles, groups, suspects, points, seeds, spacing,
-// duplicates, triangles removed, vertices fixed, payload checksum, header checksum. No timings:
-// the same tile gives the same bytes.
-constexpr std::size_t kHeaderBytes = 8 + 4 + 4 + 8 * 12;
+// duplicates, triangles removed, vertices fixed, final triangles, payload checksum, header
+// checksum. No timings: the same tile gives the same bytes.
+constexpr std::size_t kHeaderBytes = 8 + 4 + 4 + 8 * 13;
 
 }  // namespace
 
@@ -68,6 +69,7 @@ void write_tile_growth(const std::filesystem::path& file, std::uint32_t tile,
   h = io::put_le(h, growth.report.duplicates_merged);
   h = io::put_le(h, growth.report.triangles_removed);
   h = io::put_le(h, growth.report.non_manifold_vertices_fixed);
+  h = io::put_le(h, static_cast<std::uint64_t>(growth.final_triangles));
   h = io::put_le(h, tiling::xxhash64(payload.data(), payload.size()));
   io::put_le(h, tiling::xxhash64(header, kHeaderBytes - 8));
 
@@ -116,7 +118,7 @@ TileGrowth read_tile_growth(const std::filesystem::path& file, std::uint32_t til
                     bytes.size() - kHeaderBytes, triangles, suspects));
   }
   const unsigned char* p = h + kHeaderBytes;
-  if (tiling::load_le<std::uint64_t>(h + 96) != tiling::xxhash64(p, bytes.size() - kHeaderBytes)) {
+  if (tiling::load_le<std::uint64_t>(h + 104) != tiling::xxhash64(p, bytes.size() - kHeaderBytes)) {
     throw fail("triangle checksum mismatch (the file is corrupt)");
   }
   TileGrowth g;
@@ -127,6 +129,10 @@ TileGrowth read_tile_growth(const std::filesystem::path& file, std::uint32_t til
   g.report.duplicates_merged = tiling::load_le<std::uint64_t>(h + 72);
   g.report.triangles_removed = tiling::load_le<std::uint64_t>(h + 80);
   g.report.non_manifold_vertices_fixed = tiling::load_le<std::uint64_t>(h + 88);
+  g.final_triangles = tiling::load_le<std::uint64_t>(h + 96);
+  if (g.final_triangles > triangles) {
+    throw fail("more final triangles than triangles (the file is corrupt)");
+  }
   g.triangles.resize(triangles);
   for (Triangle& t : g.triangles) {
     for (Index& v : t) {

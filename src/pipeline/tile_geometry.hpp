@@ -102,19 +102,26 @@ inline SeamReach seam_reach(std::span<const TileInfo> tiles, std::size_t tile,
 }
 
 // How deep inside its box a point of `tile` must lie for no seam to reach it: the largest
-// `touch` among the tile's own seam and those of the tiles whose seams reach into its box.
+// `touch` among the tile's own seam and those of the tiles whose seams reach into its box. With
+// `margin`, the depth beyond which the point is also out of reach of the release margin: its
+// triangles are final when the tile is grown.
 inline double seam_depth(std::span<const TileInfo> tiles, std::size_t tile,
-                         const PipelineOptions& options) {
+                         const PipelineOptions& options, bool margin = false) {
   double largest_spacing = 0;
   for (const TileInfo& t : tiles) largest_spacing = std::max(largest_spacing, t.spacing);
-  // No tile's touch exceeds this (its local spacing is at most the largest).
+  // No tile's reach exceeds this (its local spacing is at most the largest).
   const double bound =
-      std::max(2 * options.band_spacings, options.band_spacings + options.mesh.max_radius) *
+      (std::max(2 * options.band_spacings, options.band_spacings + options.mesh.max_radius) +
+       (margin ? 2 * options.mesh.max_radius : 0.0)) *
       largest_spacing;
-  double depth = seam_reach(tiles, tile, options).touch;
+  auto reach_of = [&](std::size_t t) {
+    const SeamReach r = seam_reach(tiles, t, options);
+    return r.touch + (margin ? r.margin : 0.0);
+  };
+  double depth = reach_of(tile);
   for (std::size_t j : tiles_near(tiles, tile, bound)) {
-    const double touch = seam_reach(tiles, j, options).touch;
-    if (box_gap(tiles[tile].box, tiles[j].box) <= touch) depth = std::max(depth, touch);
+    const double reach = reach_of(j);
+    if (box_gap(tiles[tile].box, tiles[j].box) <= reach) depth = std::max(depth, reach);
   }
   return depth;
 }

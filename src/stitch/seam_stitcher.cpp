@@ -259,7 +259,9 @@ void Stitcher::add(std::size_t tile, TileGrowth growth) {
   const auto start = std::chrono::steady_clock::now();
   const std::span<const TileInfo> tiles = m.source.tiles();
   LiveMesh& live = m.live;
-  std::vector<std::uint32_t> slot_of_point;  // per tile point: its slot
+  const auto base = static_cast<std::uint32_t>(live.groups.size());
+  for (std::uint32_t k = 0; k < growth.groups; ++k) live.add_group();
+  std::vector<std::uint32_t> slot_of_point;  // per tile point: its slot, or kNoIndex
   {
     const TilePoints points = growth.points.size() == growth.report.points
                                   ? std::move(growth.points)
@@ -267,7 +269,32 @@ void Stitcher::add(std::size_t tile, TileGrowth growth) {
     if (points.size() != growth.report.points) {
       throw Error(Exit::bad_input, "grown tile: its point count differs from the tile store's");
     }
-    slot_of_point.resize(points.size());
+    auto check = [&](Index v) {
+      if (v >= points.size()) {
+        throw Error(Exit::bad_input, "grown tile: a corner is not a point of its tile");
+      }
+      return v;
+    };
+    // The points the live mesh must hold besides those a seam can reach: corners of the
+    // triangles that are not final, and suspects.
+    std::vector<std::uint8_t> held(points.size(), 0);
+    for (std::size_t k = growth.final_triangles; k < growth.triangles.size(); ++k) {
+      for (Index v : growth.triangles[k]) held[check(v)] = 1;
+    }
+    for (Index v : growth.second_fans) held[check(v)] = 1;
+    // Final triangles go to the output now; a corner's vertex number moves into its slot if it
+    // gets one.
+    std::vector<std::uint32_t> number(points.size(), kNoIndex);
+    for (std::size_t k = 0; k < growth.final_triangles; ++k) {
+      const Triangle& t = growth.triangles[k];
+      const std::uint32_t group = base + growth.group[k];
+      emit_triangle({&number[check(t[0])], &number[check(t[1])], &number[check(t[2])]},
+                    {&points.xyz[3 * std::size_t{t[0]}], &points.xyz[3 * std::size_t{t[1]}],
+                     &points.xyz[3 * std::size_t{t[2]}]},
+                    {points.ids[t[0]], points.ids[t[1]], points.ids[t[2]]}, live.sums[group], group,
+                    m.origin, m.sink, m.released);
+    }
+    slot_of_point.assign(points.size(), kNoIndex);
     std::vector<std::size_t> later;
     double inside = 0;
     for (std::size_t j = tile + 1; j < tiles.size(); ++j) {
@@ -286,25 +313,20 @@ void Stitcher::add(std::size_t tile, TileGrowth growth) {
       }
       const double* p = &points.xyz[3 * k];
       const std::uint32_t release = m.last_step(tile, p, later, inside, true);
+      const bool listed = release != tile || box_depth(tiles[tile].box, p) <= unreachable;
+      if (!listed && !held[k]) continue;  // only in final triangles, or in none
       const std::uint32_t finish =
           release == tile ? release : m.last_step(tile, p, later, inside, false);
-      const bool listed = release != tile || box_depth(tiles[tile].box, p) <= unreachable;
       slot_of_point[k] = live.add_point(points.ids[k], p, finish, release, listed);
+      live.number[slot_of_point[k]] = number[k];
     }
   }
-  const auto base = static_cast<std::uint32_t>(live.groups.size());
-  for (std::uint32_t k = 0; k < growth.groups; ++k) live.add_group();
-  auto slot = [&](Index v) {
-    if (v >= slot_of_point.size()) {
-      throw Error(Exit::bad_input, "grown tile: a corner is not a point of its tile");
-    }
-    return slot_of_point[v];
-  };
-  for (std::size_t k = 0; k < growth.triangles.size(); ++k) {
+  for (std::size_t k = growth.final_triangles; k < growth.triangles.size(); ++k) {
     const Triangle& t = growth.triangles[k];
-    live.add_triangle({slot(t[0]), slot(t[1]), slot(t[2])}, base + growth.group[k]);
+    live.add_triangle({slot_of_point[t[0]], slot_of_point[t[1]], slot_of_point[t[2]]},
+                      base + growth.group[k]);
   }
-  for (Index v : growth.second_fans) live.flags[slot(v)] |= LiveMesh::kSuspect;
+  for (Index v : growth.second_fans) live.flags[slot_of_point[v]] |= LiveMesh::kSuspect;
   MeshReport& r = m.out.report;
   r.points += growth.report.points;
   r.seeds += growth.report.seeds;
