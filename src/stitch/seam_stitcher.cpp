@@ -12,8 +12,9 @@
 // (cleanup/release.cpp), so what stays is the band along the seams still open.
 //
 // Orientation: every triangle belongs to an orientation group (from its tile or seam); the
-// stitcher joins groups with a parity as it connects them, and the end flips each group so that
-// all of a component faces one way, and the component outward as the in-memory mesher does.
+// stitcher joins the groups meeting at a seam with the parity their normals vote for, and the
+// end flips each group so that all of a component faces one way, and the component outward as
+// the in-memory mesher does.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
