@@ -12,9 +12,9 @@
 // (cleanup/release.cpp), so what stays is the band along the seams still open.
 //
 // Orientation: every triangle belongs to an orientation group (from its tile or seam); the
-// stitcher joins the groups meeting at a seam with the parity their normals vote for, and the
-// end flips each group so that all of a component faces one way, and the component outward as
-// the in-memory mesher does.
+// stitcher joins the groups meeting at a seam with the parity their normals vote for (where the
+// vote is clear; others as it connects them), and the end flips each group so that all of a
+// component faces one way, and the component outward as the in-memory mesher does.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -224,7 +224,10 @@ class SeamStitcher {
   // groups would decide it, and on noisy or layered scans that triangle is often a fold: every
   // later triangle along the seam then contradicts it and is refused, leaving a crack. Each
   // band point votes for its group and the group of its nearest point of another group (within
-  // 3 spacings) with the dot product of their normals; the strongest pairs are joined first.
+  // 3 spacings) with the dot product of their normals, if that point lies along the surface
+  // (within 30 degrees of the point's tangent plane): one across it may be the other sheet of a
+  // thin part, which faces the other way. The strongest pairs are joined first; a pair whose
+  // sum is within twice the spread of as many random votes is left to the grower.
   void vote_orientation(const HashGrid& grid, std::span<const std::uint8_t> growable) {
     const std::uint32_t n = grid.size();
     label_.assign(n, kNoIndex);
@@ -244,7 +247,8 @@ class SeamStitcher {
       if (!growable[v] || label_[v] == kNoIndex || norm2(normal_[v]) == 0) continue;
       std::uint32_t other = kNoIndex;
       double nearest = radius * radius;
-      grid.for_each_in_ball(grid.position(v), radius, [&](std::uint32_t w, double d2) {
+      const Vec3 pv = grid.position(v), nv = normalized(normal_[v]);
+      grid.for_each_in_ball(pv, radius, [&](std::uint32_t w, double d2) {
         if (label_[w] == kNoIndex || label_[w] == label_[v] || norm2(normal_[w]) == 0) return;
         if (d2 < nearest || (d2 == nearest && w < other)) {
           nearest = d2;
@@ -252,8 +256,10 @@ class SeamStitcher {
         }
       });
       if (other == kNoIndex) continue;
+      const double across = dot(grid.position(other) - pv, nv);
+      if (4 * across * across > nearest) continue;
       votes_.push_back({std::min(label_[v], label_[other]), std::max(label_[v], label_[other]),
-                        dot(normalized(normal_[v]), normalized(normal_[other]))});
+                        dot(nv, normalized(normal_[other])), 1});
     }
     // Sums per pair (in a fixed order: the same bytes on every run), strongest first.
     std::sort(votes_.begin(), votes_.end(), [](const Vote& x, const Vote& y) {
@@ -263,6 +269,7 @@ class SeamStitcher {
     for (const Vote& x : votes_) {
       if (pairs > 0 && votes_[pairs - 1].a == x.a && votes_[pairs - 1].b == x.b) {
         votes_[pairs - 1].sum += x.sum;
+        ++votes_[pairs - 1].count;
       } else {
         votes_[pairs++] = x;
       }
@@ -274,13 +281,15 @@ class SeamStitcher {
     });
     links_.clear();
     for (const Vote& x : votes_) {
-      if (x.sum != 0) links_.push_back({x.a, x.b, static_cast<std::uint8_t>(x.sum < 0)});
+      if (std::abs(x.sum) < 2 * std::sqrt(static_cast<double>(x.count))) continue;
+      links_.push_back({x.a, x.b, static_cast<std::uint8_t>(x.sum < 0)});
     }
   }
 
   struct Vote {
     std::uint32_t a, b;  // labels, a < b
     double sum;          // > 0: they face the same way as preloaded
+    std::uint32_t count;
   };
 
   const TileSource& source_;
