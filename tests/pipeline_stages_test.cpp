@@ -206,8 +206,8 @@ TEST(PipelineSeams, ThroughTheSharpEdgesOfACube) {
 TEST(PipelineSeams, ThroughAThinPlate) {
   g2s::SynthOptions o;
   o.shape = g2s::SynthShape::plate;  // 2 x 2 x 0.05, closed
-  // Sheets 3.6 and 2 spacings apart: closer than the stitcher's orientation vote looks, where
-  // each sheet must not vote the other to face its way.
+  // Sheets 3.6 and 2 spacings apart: in the second, each sheet is within the reach of the
+  // stitcher's orientation vote (3 spacings) of the other and must not vote it to face its way.
   for (const int points : {30000, 9000}) {
     o.points = points;
     const g2s::PointCloud cloud = g2s::make_synthetic_cloud(o);
