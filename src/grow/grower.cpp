@@ -72,7 +72,7 @@ class Grower {
 
   GrowResult run(const GrowContext& context) {
     GrowResult result;
-    load(context.preload, context.preload_group);
+    load(context.preload, context.preload_group, context.preload_links);
     drain();
     for (std::uint32_t i = 0; i < grid_.size(); ++i) {
       if (used_[i] || seed_tried_[i] || !growable(i)) continue;
@@ -99,8 +99,9 @@ class Grower {
   bool growable(Index i) const { return growable_.empty() || growable_[i]; }
 
   // Enters the triangles kept before this run, each its own orientation group (joined where they
-  // share an edge); their open edges at growable points become the front.
-  void load(std::span<const Triangle> preload, std::span<const std::uint32_t> labels) {
+  // share an edge, and as `links` say); their open edges at growable points become the front.
+  void load(std::span<const Triangle> preload, std::span<const std::uint32_t> labels,
+            std::span<const GrowContext::Link> links) {
     std::vector<std::pair<std::uint32_t, std::uint32_t>> label_group;  // sorted by label
     for (std::size_t k = 0; k < preload.size(); ++k) {
       std::uint32_t group = 0;
@@ -120,6 +121,15 @@ class Grower {
       add_triangle(t[0], t[1], t[2], group, 0, false);
     }
     preloaded_ = preload.size();
+    auto group_of = [&](std::uint32_t label) {
+      const auto at =
+          std::lower_bound(label_group.begin(), label_group.end(), std::pair{label, 0u});
+      return at != label_group.end() && at->first == label ? at->second : kNoIndex;
+    };
+    for (const GrowContext::Link& link : links) {
+      const std::uint32_t a = group_of(link.a), b = group_of(link.b);
+      if (a != kNoIndex && b != kNoIndex) groups_.unite(a, b, link.parity);
+    }
     for (std::uint32_t t = 0; t < preloaded_; ++t) {
       for (int k = 0; k < 3; ++k) {
         const Index u = triangles_[t][k], v = triangles_[t][(k + 1) % 3];

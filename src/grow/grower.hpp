@@ -19,6 +19,13 @@ struct GrowContext {
   // start in one orientation group); empty: every triangle its own group.
   std::span<const std::uint32_t> preload_group;
   std::span<const std::uint8_t> growable;  // per grid point, non-zero: usable; empty: all
+  // Pairs of labels known to face the same way (parity 0) or opposite ways (1) as given, joined
+  // in this order before growing; a link that contradicts earlier ones is skipped.
+  struct Link {
+    std::uint32_t a, b;
+    std::uint8_t parity;
+  };
+  std::span<const Link> preload_links;
   // How many more points, in Gabriel order, an edge tries when its Gabriel point cannot join.
   int retries = 0;
 };

@@ -12,11 +12,14 @@
 // (cleanup/release.cpp), so what stays is the band along the seams still open.
 //
 // Orientation: every triangle belongs to an orientation group (from its tile or seam); the
-// stitcher joins groups with a parity as it connects them, and the end flips each group so that
-// all of a component faces one way, and the component outward as the in-memory mesher does.
+// stitcher joins the groups meeting at a seam with the parity their normals vote for (where the
+// vote is clear; others as it connects them), and the end flips each group so that all of a
+// component faces one way, and the component outward as the in-memory mesher does.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <numeric>
+#include <tuple>
 
 #include "cleanup/release.hpp"
 #include "common/id_map.hpp"
@@ -129,10 +132,12 @@ class SeamStitcher {
       growable[k] = growable_[local_of_.find(grid.id(k))];
     }
 
+    vote_orientation(grid, growable);
+
     MeshOptions mesh_options = options_.mesh;
     mesh_options.progress = {};
-    GrowResult grown = grow_mesh(grid, mesh_options,
-                                 {preload_, preload_group_, growable, options_.stitch_retries});
+    GrowResult grown = grow_mesh(
+        grid, mesh_options, {preload_, preload_group_, growable, links_, options_.stitch_retries});
 
     // Orientation: per grower group, the first preloaded triangle anchors it to a live group.
     const std::size_t preloaded = preload_.size();
@@ -190,6 +195,79 @@ class SeamStitcher {
   }
 
  private:
+  // How the live groups meeting at this seam face each other, decided before growing by a vote
+  // of the surface normals on both sides. Left to the grower, the first triangle to join two
+  // groups would decide it, and on noisy or layered scans that triangle is often a fold: every
+  // later triangle along the seam then contradicts it and is refused, leaving a crack. Each
+  // band point votes for its group and the group of its nearest point of another group (within
+  // 3 spacings) with the dot product of their normals, if that point lies along the surface
+  // (within 30 degrees of the point's tangent plane): one across it may be the other sheet of a
+  // thin part, which faces the other way. The strongest pairs are joined first; a pair whose
+  // sum is within twice the spread of as many random votes is left to the grower.
+  void vote_orientation(const HashGrid& grid, std::span<const std::uint8_t> growable) {
+    const std::uint32_t n = grid.size();
+    label_.assign(n, kNoIndex);
+    normal_.assign(n, Vec3{0, 0, 0});
+    for (std::size_t k = 0; k < preload_.size(); ++k) {
+      const Triangle& t = preload_[k];
+      const Vec3 a = grid.position(t[0]);
+      const Vec3 area = cross(grid.position(t[1]) - a, grid.position(t[2]) - a);
+      for (Index v : t) {
+        if (label_[v] == kNoIndex) label_[v] = preload_group_[k];
+        if (label_[v] == preload_group_[k]) normal_[v] = normal_[v] + area;
+      }
+    }
+    votes_.clear();
+    const double radius = 3 * grid.spacing();
+    for (std::uint32_t v = 0; v < n; ++v) {
+      if (!growable[v] || label_[v] == kNoIndex || norm2(normal_[v]) == 0) continue;
+      std::uint32_t other = kNoIndex;
+      double nearest = radius * radius;
+      const Vec3 pv = grid.position(v), nv = normalized(normal_[v]);
+      grid.for_each_in_ball(pv, radius, [&](std::uint32_t w, double d2) {
+        if (label_[w] == kNoIndex || label_[w] == label_[v] || norm2(normal_[w]) == 0) return;
+        if (d2 < nearest || (d2 == nearest && w < other)) {
+          nearest = d2;
+          other = w;
+        }
+      });
+      if (other == kNoIndex) continue;
+      const double across = dot(grid.position(other) - pv, nv);
+      if (4 * across * across > nearest) continue;
+      votes_.push_back({std::min(label_[v], label_[other]), std::max(label_[v], label_[other]),
+                        dot(nv, normalized(normal_[other])), 1});
+    }
+    // Sums per pair (in a fixed order: the same bytes on every run), strongest first.
+    std::sort(votes_.begin(), votes_.end(), [](const Vote& x, const Vote& y) {
+      return std::tie(x.a, x.b, x.sum) < std::tie(y.a, y.b, y.sum);
+    });
+    std::size_t pairs = 0;
+    for (const Vote& x : votes_) {
+      if (pairs > 0 && votes_[pairs - 1].a == x.a && votes_[pairs - 1].b == x.b) {
+        votes_[pairs - 1].sum += x.sum;
+        ++votes_[pairs - 1].count;
+      } else {
+        votes_[pairs++] = x;
+      }
+    }
+    votes_.resize(pairs);
+    std::sort(votes_.begin(), votes_.end(), [](const Vote& x, const Vote& y) {
+      const double ax = std::abs(x.sum), ay = std::abs(y.sum);
+      return ax != ay ? ax > ay : std::tie(x.a, x.b) < std::tie(y.a, y.b);
+    });
+    links_.clear();
+    for (const Vote& x : votes_) {
+      if (std::abs(x.sum) < 2 * std::sqrt(static_cast<double>(x.count))) continue;
+      links_.push_back({x.a, x.b, static_cast<std::uint8_t>(x.sum < 0)});
+    }
+  }
+
+  struct Vote {
+    std::uint32_t a, b;  // labels, a < b
+    double sum;          // > 0: they face the same way as preloaded
+    std::uint32_t count;
+  };
+
   const TileSource& source_;
   const PipelineOptions& options_;
   IdMap local_of_;  // global id -> index in ids_, for the points of the current seam
@@ -198,6 +276,11 @@ class SeamStitcher {
   std::vector<std::uint8_t> growable_;
   std::vector<Triangle> preload_;
   std::vector<std::uint32_t> preload_group_;
+  // The orientation vote's scratch: per seam grid point, its label and normal.
+  std::vector<std::uint32_t> label_;
+  std::vector<Vec3> normal_;
+  std::vector<Vote> votes_;
+  std::vector<GrowContext::Link> links_;
 };
 
 }  // namespace
