@@ -208,6 +208,12 @@ class Grower {
     FrontEdge e;
     while (!queue_.empty()) {
       const int level = queue_.pop(e);
+      // Processing an edge is bound by memory latency: start loading what the edge after the
+      // next one will look up first.
+      if (const FrontEdge* next = queue_.peek(1)) {
+        edges_.prefetch(next->a, next->b);
+        __builtin_prefetch(&triangles_[next->triangle]);
+      }
       if (edges_.find(e.a, e.b) != e.triangle) continue;  // closed meanwhile
       if (e.cand != kNoIndex) {
         if (!interior(e.cand) && try_add(e, e.cand)) continue;
