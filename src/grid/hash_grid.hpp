@@ -34,9 +34,32 @@ class HashGrid {
   double spacing() const { return spacing_; }  // mean nearest-neighbour distance (sampled)
   double cell_size() const { return cell_; }
 
+  // A ball query as for_each_in_ball answers it: the test and the cells it scans.
+  class BallQuery {
+   public:
+    BallQuery(const HashGrid& grid, const Vec3& centre, double radius);
+    // Exactly whether the query visits point i (and with which squared distance).
+    bool visits(const HashGrid& grid, std::uint32_t i) const;
+
+   private:
+    friend class HashGrid;
+    double d2_of(const Vec3f& p) const {
+      const double dx = p.x - centre_.x, dy = p.y - centre_.y, dz = p.z - centre_.z;
+      return dx * dx + dy * dy + dz * dz;
+    }
+    Vec3 centre_;
+    double r2_;
+    std::int64_t lo_[3], hi_[3];  // the cells' box
+    bool scan_all_;  // a ball spanning more cells than there are points: scan the points
+  };
+
   // Calls visit(i, squared distance) for every point within radius of centre.
   template <class Visit>
-  void for_each_in_ball(const Vec3& centre, double radius, Visit&& visit) const;
+  void for_each_in_ball(const Vec3& centre, double radius, Visit&& visit) const {
+    for_each_in_ball(BallQuery(*this, centre, radius), visit);
+  }
+  template <class Visit>
+  void for_each_in_ball(const BallQuery& query, Visit&& visit) const;
 
   // Nearest point to point i among those accepted by keep(j), within max_radius; kNoIndex if
   // none.
@@ -128,24 +151,41 @@ constexpr std::uint64_t block_slab(int axis, int lo, int hi) {
   return mask;
 }
 
-template <class Visit>
-void HashGrid::for_each_in_ball(const Vec3& centre, double radius, Visit&& visit) const {
-  const double r2 = radius * radius;
+inline HashGrid::BallQuery::BallQuery(const HashGrid& grid, const Vec3& centre, double radius)
+    : centre_(centre), r2_(radius * radius) {
   const double c[3] = {centre.x, centre.y, centre.z};
-  std::int64_t lo[3], hi[3];
   // A ball spanning more cells than there are points (far outliers, very uneven density) is
   // cheaper to answer by scanning the points than by probing mostly empty cells.
   double box_cells = 1;
   for (int a = 0; a < 3; ++a) {
-    lo[a] = clamped_coord(c[a] - radius, a);
-    hi[a] = clamped_coord(c[a] + radius, a);
-    box_cells *= static_cast<double>(hi[a] - lo[a] + 1);
+    lo_[a] = grid.clamped_coord(c[a] - radius, a);
+    hi_[a] = grid.clamped_coord(c[a] + radius, a);
+    box_cells *= static_cast<double>(hi_[a] - lo_[a] + 1);
   }
-  if (box_cells > static_cast<double>(points_.size())) {
+  scan_all_ = box_cells > static_cast<double>(grid.size());
+}
+
+inline bool HashGrid::BallQuery::visits(const HashGrid& grid, std::uint32_t i) const {
+  const Vec3f& p = grid.point(i);
+  if (!(d2_of(p) <= r2_)) return false;
+  if (scan_all_) return true;
+  // The cell the point was sorted into (build() bins it the same way).
+  const double v[3] = {p.x, p.y, p.z};
+  for (int a = 0; a < 3; ++a) {
+    const std::int64_t cell = grid.clamped_coord(v[a], a);
+    if (cell < lo_[a] || cell > hi_[a]) return false;
+  }
+  return true;
+}
+
+template <class Visit>
+void HashGrid::for_each_in_ball(const BallQuery& query, Visit&& visit) const {
+  const double r2 = query.r2_;
+  const std::int64_t* lo = query.lo_;
+  const std::int64_t* hi = query.hi_;
+  if (query.scan_all_) {
     for (std::uint32_t i = 0; i < points_.size(); ++i) {
-      const Vec3f& p = points_[i];
-      const double dx = p.x - centre.x, dy = p.y - centre.y, dz = p.z - centre.z;
-      const double d2 = dx * dx + dy * dy + dz * dz;
+      const double d2 = query.d2_of(points_[i]);
       if (d2 <= r2) visit(i, d2);
     }
     return;
@@ -195,9 +235,7 @@ void HashGrid::for_each_in_ball(const Vec3& centre, double radius, Visit&& visit
           for (std::uint32_t i = cell_begin_[k],
                              end = cell_begin_[k + static_cast<std::size_t>(run)];
                i < end; ++i) {
-            const Vec3f& p = points_[i];
-            const double dx = p.x - centre.x, dy = p.y - centre.y, dz = p.z - centre.z;
-            const double d2 = dx * dx + dy * dy + dz * dz;
+            const double d2 = query.d2_of(points_[i]);
             found[count] = i;
             found_d2[count] = d2;
             count += d2 <= r2;

@@ -264,7 +264,11 @@ class Grower {
   // The point to grow edge e onto, and its priority value m*(radius level) + flatness level.
   // The search balls of all levels pass through a and b with centres on the same ray, so on the
   // growing side each contains the one before: the level-1 ball is gathered first (most edges
-  // stop there), then, if needed, the largest once, and each level filters it by its own ball.
+  // stop there), then, if needed, the level-2 ball, then the largest once, and each level
+  // filters its pool by its own ball. The level-2 pool is the part of the largest ball's that the
+  // level-2 ball (widened far beyond rounding) holds, so every level sees the same candidates as
+  // if all were filtered from the largest ball; it saves gathering the largest ball (eight times
+  // the volume) for the edges that stop at level 2.
   Candidate find_candidate(const FrontEdge& e) {
     const Index c = apex(triangles_[e.triangle], e.a, e.b);
     const Vec3 a = grid_.position(e.a), b = grid_.position(e.b), pc = grid_.position(c);
@@ -281,22 +285,42 @@ class Grower {
       along = std::sqrt(std::max(radius * radius - 0.25 * len * len, 0.0));
       return radius;
     };
-    auto gather = [&](int level) {
+    // The level's ball, its radius widened by `widen` (relative, plus as much of the coordinates'
+    // size, scaled by 1e-5, for the rounding of the centre).
+    auto query_of = [&](int level, double widen) {
       double along = 0;
       const double radius = ball_of(level, along);
+      const double size = std::abs(mid.x) + std::abs(mid.y) + std::abs(mid.z);
+      return HashGrid::BallQuery(grid_, mid + out * along,
+                                 radius * (1 + widen) + widen * 1e-5 * size);
+    };
+    // within: the query whose pool this one's is part of, or nullptr.
+    auto gather = [&](const HashGrid::BallQuery& query, const HashGrid::BallQuery* within) {
       pool_.clear();
-      grid_.for_each_in_ball(mid + out * along, radius, [&](std::uint32_t j, double) {
+      grid_.for_each_in_ball(query, [&](std::uint32_t j, double) {
         if (j == e.a || j == e.b || j == c || interior(j)) return;
         if (std::find(excluded_.begin(), excluded_.end(), j) != excluded_.end()) return;
         const Vec3 d = grid_.position(j) - mid;
         const double ahead = dot(d, out);
         if (ahead <= 0) return;
+        if (within && !within->visits(grid_, j)) return;
         pool_.push_back({j, norm2(d), ahead});
       });
     };
-    gather(0);
+    gather(query_of(0, 0), nullptr);
+    double unused = 0;
+    const bool split = levels_ > 2 && ball_of(1, unused) < ball_of(levels_ - 1, unused);
     for (int level = 0; level < levels_; ++level) {
-      if (level == 1) gather(levels_ - 1);
+      if (level == 1) {
+        const HashGrid::BallQuery largest = query_of(levels_ - 1, 0);
+        if (split) {
+          gather(query_of(1, 1e-7), &largest);
+        } else {
+          gather(largest, nullptr);
+        }
+      } else if (level == 2 && split) {
+        gather(query_of(levels_ - 1, 0), nullptr);
+      }
       double along = 0;
       ball_of(level, along);
       // Inside this level's ball: |q - mid - along*out|^2 <= radius^2 = along^2 + len^2/4.
