@@ -68,6 +68,10 @@ class Grower {
         radius_floor_(0.5 * grid.spacing()),
         radius_cap_(options.max_radius * grid.spacing()) {
     triangles_.reserve(std::size_t{2} * grid.size());
+    // (Outside (0, pi], cos does not order the angles as needed: acos decides.)
+    for (int k = 1; k <= flat_levels_ && max_fold_ > 0 && max_fold_ <= std::numbers::pi; ++k) {
+      bound_cos_.push_back(std::cos(k * max_fold_ / flat_levels_));
+    }
   }
 
   GrowResult run(const GrowContext& context) {
@@ -332,16 +336,29 @@ class Grower {
         const Index p = gabriel_walk(grid_, a, b, mid, cand_);
         if (p == kNoIndex) break;
         const Vec3 n_new = normalized(cross(a - b, grid_.position(p) - b));
-        const double beta = std::acos(std::clamp(dot(n, n_new), -1.0, 1.0));
-        if (beta <= max_fold_ && growable(p)) {
-          const int flat =
-              std::min(flat_levels_ - 1, static_cast<int>(beta / max_fold_ * flat_levels_));
-          return {p, level * flat_levels_ + flat};
-        }
+        const int flat = flatness(std::clamp(dot(n, n_new), -1.0, 1.0));
+        if (flat >= 0 && growable(p)) return {p, level * flat_levels_ + flat};
         break;  // a fold, or context the run may not use
       }
     }
     return {};
+  }
+
+  // The flatness level of a new triangle whose normal makes an angle beta = acos(cos_beta) with
+  // its front triangle's: beta in max_fold_ / flat_levels_ steps, -1 beyond max_fold_ (a fold).
+  // Decided by comparing cos_beta with the steps' cosines; only within 1e-9 of one, far beyond
+  // the rounding of either side, does acos decide, so the level is always the one acos gives.
+  int flatness(double cos_beta) const {
+    int flat = 0;
+    bool near = bound_cos_.empty();
+    for (const double bound : bound_cos_) {
+      near |= !(std::abs(cos_beta - bound) > 1e-9);
+      flat += cos_beta < bound;
+    }
+    if (!near) return flat == flat_levels_ ? -1 : flat;
+    const double beta = std::acos(cos_beta);
+    if (!(beta <= max_fold_)) return -1;
+    return std::min(flat_levels_ - 1, static_cast<int>(beta / max_fold_ * flat_levels_));
   }
 
   // Adds triangle (b, a, p) across front edge a->b if the Point-Edge Map allows it: no edge gets
@@ -458,6 +475,7 @@ class Grower {
   const int last_priority_;
   const double max_fold_;
   const double cos_max_fold_;
+  std::vector<double> bound_cos_;  // cos(k * max_fold_ / flat_levels_), k = 1..flat_levels_
   const double radius_floor_;
   const double radius_cap_;
   // Scratch, reused across edges so the inner loop does not allocate.
