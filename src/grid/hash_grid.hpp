@@ -214,6 +214,22 @@ void HashGrid::for_each_in_ball(const BallQuery& query, Visit&& visit) const {
     for (std::size_t f = 0; f < count; ++f) visit(found[f], found_d2[f]);
     count = 0;
   };
+  // The point ranges to scan are collected first, their first points prefetched, and scanned
+  // after: the cache misses of a query's cells then overlap instead of following one another.
+  std::uint32_t range_begin[16], range_end[16];
+  std::size_t ranges = 0;
+  const auto scan = [&] {
+    for (std::size_t r = 0; r < ranges; ++r) {
+      for (std::uint32_t i = range_begin[r]; i < range_end[r]; ++i) {
+        const double d2 = query.d2_of(points_[i]);
+        found[count] = i;
+        found_d2[count] = d2;
+        count += d2 <= r2;
+        if (count == std::size(found)) flush();
+      }
+    }
+    ranges = 0;
+  };
   // Block by block, the non-empty cells in the query's box come from the masks at once; cells
   // consecutive in Morton order have consecutive points, so each run of them is one range.
   for (std::int64_t bz = lo[2] >> 2; bz <= hi[2] >> 2; ++bz) {
@@ -232,19 +248,15 @@ void HashGrid::for_each_in_ball(const BallQuery& query, Visit&& visit) const {
           const std::size_t k =
               block->first + bit_count(block->cells & ((std::uint64_t{1} << start) - 1));
           cells = start + run >= 64 ? 0 : cells & (~0ull << (start + run));
-          for (std::uint32_t i = cell_begin_[k],
-                             end = cell_begin_[k + static_cast<std::size_t>(run)];
-               i < end; ++i) {
-            const double d2 = query.d2_of(points_[i]);
-            found[count] = i;
-            found_d2[count] = d2;
-            count += d2 <= r2;
-            if (count == std::size(found)) flush();
-          }
+          range_begin[ranges] = cell_begin_[k];
+          range_end[ranges] = cell_begin_[k + static_cast<std::size_t>(run)];
+          __builtin_prefetch(&points_[range_begin[ranges]]);
+          if (++ranges == std::size(range_begin)) scan();
         }
       }
     }
   }
+  scan();
   flush();
 }
 
