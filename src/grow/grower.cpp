@@ -27,9 +27,8 @@ struct FrontEdge {
 };
 
 struct PoolPoint {
-  Index index;
-  double dist2;  // squared distance to the edge midpoint
-  double ahead;  // distance along the growing direction
+  WalkPoint walk;  // dist2: squared distance to the edge midpoint
+  double ahead;    // distance along the growing direction
 };
 
 struct Candidate {
@@ -58,9 +57,8 @@ class Grower {
         levels_(static_cast<int>(options.radius_steps.size())),
         flat_levels_(std::max(1, options.flatness_levels)),
         edges_(grid.size()),
-        used_(grid.size(), 0),
         seed_tried_(grid.size(), 0),
-        open_count_(grid.size(), 0),
+        state_(grid.size(), 0),
         queue_(std::max(1, levels_ * flat_levels_)),
         last_priority_(std::max(1, levels_ * flat_levels_) - 1),
         max_fold_(options.max_fold_deg * std::numbers::pi / 180.0),
@@ -79,7 +77,7 @@ class Grower {
     load(context.preload, context.preload_group);
     drain();
     for (std::uint32_t i = 0; i < grid_.size(); ++i) {
-      if (used_[i] || seed_tried_[i] || !growable(i)) continue;
+      if (used(i) || seed_tried_[i] || !growable(i)) continue;
       seed_tried_[i] = 1;
       if (!try_seed(i)) continue;
       ++result.seeds;
@@ -99,7 +97,8 @@ class Grower {
   }
 
  private:
-  bool interior(Index i) const { return used_[i] && open_count_[i] == 0; }
+  bool used(Index i) const { return state_[i] & kUsed; }
+  bool interior(Index i) const { return state_[i] == kUsed; }
   bool growable(Index i) const { return growable_.empty() || growable_[i]; }
 
   // Enters the triangles kept before this run, each its own orientation group (joined where they
@@ -187,22 +186,22 @@ class Grower {
       const std::uint32_t other = edges_.find(u, v);
       edges_.add(u, v, t);
       if (other != EdgeMap::kMissing) {
-        --open_count_[u];
-        --open_count_[v];
+        --state_[u];
+        --state_[v];
         if (!grow) {  // preloaded neighbours: record how their groups face
           groups_.unite(
               group, group_[other & ~EdgeMap::kClosed],
               static_cast<std::uint8_t>(!traverses(triangles_[other & ~EdgeMap::kClosed], v, u)));
         }
       } else {
-        ++open_count_[u];
-        ++open_count_[v];
+        ++state_[u];
+        ++state_[v];
         if (grow) queue_.push(0, {u, v, t, kNoIndex});
       }
     }
     for (Index v : corners) {
-      used_count_ += !used_[v];
-      used_[v] = 1;
+      used_count_ += !used(v);
+      state_[v] |= kUsed;
     }
     if (options_.progress && (t & 0xFFFF) == 0) options_.progress(used_count_, grid_.size());
   }
@@ -217,6 +216,11 @@ class Grower {
       if (const FrontEdge* next = queue_.peek(1)) {
         edges_.prefetch(next->a, next->b);
         __builtin_prefetch(&triangles_[next->triangle]);
+        if (next->cand != kNoIndex) {  // re-validated by try_add
+          __builtin_prefetch(&state_[next->cand]);
+          edges_.prefetch(next->a, next->cand);
+          edges_.prefetch(next->cand, next->b);
+        }
       }
       if (edges_.find(e.a, e.b) != e.triangle) continue;  // closed meanwhile
       if (e.cand != kNoIndex) {
@@ -232,11 +236,11 @@ class Grower {
       const Candidate c = find_candidate(e);
       if (c.point == kNoIndex) continue;
       int priority = c.priority;
-      const std::uint32_t on_ap = used_[c.point] ? edges_.find(e.a, c.point) : EdgeMap::kMissing;
-      const std::uint32_t on_pb = used_[c.point] ? edges_.find(c.point, e.b) : EdgeMap::kMissing;
+      const std::uint32_t on_ap = used(c.point) ? edges_.find(e.a, c.point) : EdgeMap::kMissing;
+      const std::uint32_t on_pb = used(c.point) ? edges_.find(c.point, e.b) : EdgeMap::kMissing;
       // Touching a used point only at the vertex starts a second fan there: wait until the
       // last level, when the fronts around it may have joined it along an edge instead.
-      if (used_[c.point] && on_ap == EdgeMap::kMissing && on_pb == EdgeMap::kMissing) {
+      if (used(c.point) && on_ap == EdgeMap::kMissing && on_pb == EdgeMap::kMissing) {
         priority = last_priority_;
       }
       if (priority > level) {
@@ -254,11 +258,11 @@ class Grower {
     for (int k = 0; k < retries_; ++k) {
       const Candidate c = find_candidate(e);
       if (c.point == kNoIndex) break;
-      const bool used = used_[c.point];
-      const std::uint32_t on_ap = used ? edges_.find(e.a, c.point) : EdgeMap::kMissing;
-      const std::uint32_t on_pb = used ? edges_.find(c.point, e.b) : EdgeMap::kMissing;
+      const bool was_used = used(c.point);
+      const std::uint32_t on_ap = was_used ? edges_.find(e.a, c.point) : EdgeMap::kMissing;
+      const std::uint32_t on_pb = was_used ? edges_.find(c.point, e.b) : EdgeMap::kMissing;
       // Only a point that is free or closes the crack along an edge: not a second fan.
-      const bool fan = used && on_ap == EdgeMap::kMissing && on_pb == EdgeMap::kMissing;
+      const bool fan = was_used && on_ap == EdgeMap::kMissing && on_pb == EdgeMap::kMissing;
       if (!fan && try_add(e, c.point, on_ap, on_pb)) break;
       excluded_.push_back(c.point);
     }
@@ -304,18 +308,20 @@ class Grower {
       grid_.for_each_in_ball(query, [&](std::uint32_t j, double) {
         if (j == e.a || j == e.b || j == c || interior(j)) return;
         if (std::find(excluded_.begin(), excluded_.end(), j) != excluded_.end()) return;
-        const Vec3 d = grid_.position(j) - mid;
+        const Vec3 q = grid_.position(j);
+        const Vec3 d = q - mid;
         const double ahead = dot(d, out);
         if (ahead <= 0) return;
         if (within && !within->visits(grid_, j)) return;
-        pool_.push_back({j, norm2(d), ahead});
+        pool_.push_back({{q, norm2(d), j}, ahead});
       });
     };
     gather(query_of(0, 0), nullptr);
-    double unused = 0;
-    const bool split = levels_ > 2 && ball_of(1, unused) < ball_of(levels_ - 1, unused);
+    bool split = false;
     for (int level = 0; level < levels_; ++level) {
       if (level == 1) {
+        double unused = 0;
+        split = levels_ > 2 && ball_of(1, unused) < ball_of(levels_ - 1, unused);
         const HashGrid::BallQuery largest = query_of(levels_ - 1, 0);
         if (split) {
           gather(query_of(1, 1e-7), &largest);
@@ -330,10 +336,10 @@ class Grower {
       // Inside this level's ball: |q - mid - along*out|^2 <= radius^2 = along^2 + len^2/4.
       cand_.clear();
       for (const PoolPoint& q : pool_) {
-        if (q.dist2 - 2 * along * q.ahead <= 0.25 * len * len) cand_.push_back(q.index);
+        if (q.walk.dist2 - 2 * along * q.ahead <= 0.25 * len * len) cand_.push_back(q.walk);
       }
       while (!cand_.empty()) {
-        const Index p = gabriel_walk(grid_, a, b, mid, cand_);
+        const Index p = gabriel_walk(a, b, cand_);
         if (p == kNoIndex) break;
         const Vec3 n_new = normalized(cross(a - b, grid_.position(p) - b));
         const int flat = flatness(std::clamp(dot(n, n_new), -1.0, 1.0));
@@ -364,7 +370,7 @@ class Grower {
   // Adds triangle (b, a, p) across front edge a->b if the Point-Edge Map allows it: no edge gets
   // a third triangle, shared edges are traversed in opposite directions, no duplicate, no fold.
   bool try_add(const FrontEdge& e, Index p) {
-    if (!used_[p]) return try_add(e, p, EdgeMap::kMissing, EdgeMap::kMissing);
+    if (!used(p)) return try_add(e, p, EdgeMap::kMissing, EdgeMap::kMissing);
     return try_add(e, p, edges_.find(e.a, p), edges_.find(p, e.b));
   }
 
@@ -392,7 +398,7 @@ class Grower {
       if (facing * dot(n_new, normal_of(on_pb)) < cos_max_fold_) return false;
     }
     if (!join_groups(e.triangle, e.a, p, e.b, on_ap, on_pb)) return false;
-    if (used_[p] && on_ap == EdgeMap::kMissing && on_pb == EdgeMap::kMissing) {
+    if (used(p) && on_ap == EdgeMap::kMissing && on_pb == EdgeMap::kMissing) {
       second_fans_.push_back(p);
     }
     add_triangle(e.b, e.a, p, group_[e.triangle], flip_[e.triangle]);
@@ -404,7 +410,7 @@ class Grower {
   // on both sides (it does not bridge a thin part).
   bool try_seed(Index i) {
     const double spacing = std::max(grid_.spacing(), 1e-30);
-    const auto unused = [&](std::uint32_t j) { return !used_[j] && growable(j); };
+    const auto unused = [&](std::uint32_t j) { return !used(j) && growable(j); };
     const Index q = grid_.nearest(i, 4.0 * spacing, unused);
     if (q == kNoIndex) return false;
     const Vec3 p0 = grid_.position(i), p1 = grid_.position(q);
@@ -417,7 +423,7 @@ class Grower {
     std::sort(near_.begin(), near_.end());
     for (const auto& candidate : near_) {
       const std::uint32_t r = candidate.second;  // a named variable: lambdas below capture it
-      if (r == i || r == q || used_[r] || !growable(r)) continue;
+      if (r == i || r == q || used(r) || !growable(r)) continue;
       const Vec3 p2 = grid_.position(r);
       Ball ball;
       if (!circumball(p0, p1, p2, ball)) continue;
@@ -467,9 +473,11 @@ class Grower {
   ParityUnionFind groups_;
   std::vector<Index> second_fans_;
   EdgeMap edges_;
-  std::vector<std::uint8_t> used_;
   std::vector<std::uint8_t> seed_tried_;
-  std::vector<std::uint32_t> open_count_;
+  // Per point: kUsed once it is a corner, plus the number of open edges at it; one array, so
+  // that the interior test of every point a search ball holds is a single load.
+  static constexpr std::uint32_t kUsed = 0x80000000u;
+  std::vector<std::uint32_t> state_;
   std::uint64_t used_count_ = 0;
   BucketQueue<FrontEdge> queue_;
   const int last_priority_;
@@ -480,7 +488,7 @@ class Grower {
   const double radius_cap_;
   // Scratch, reused across edges so the inner loop does not allocate.
   std::vector<PoolPoint> pool_;
-  std::vector<Index> cand_;
+  std::vector<WalkPoint> cand_;
   std::vector<Index> excluded_;  // points a retried edge has already failed with
   std::vector<std::pair<double, std::uint32_t>> near_;
 };
