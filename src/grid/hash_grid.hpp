@@ -43,8 +43,8 @@ class HashGrid {
 
    private:
     friend class HashGrid;
-    double d2_of(const Vec3f& p) const {
-      const double dx = p.x - centre_.x, dy = p.y - centre_.y, dz = p.z - centre_.z;
+    static double d2_of(const Vec3f& p, const Vec3& centre) {
+      const double dx = p.x - centre.x, dy = p.y - centre.y, dz = p.z - centre.z;
       return dx * dx + dy * dy + dz * dz;
     }
     Vec3 centre_;
@@ -167,7 +167,7 @@ inline HashGrid::BallQuery::BallQuery(const HashGrid& grid, const Vec3& centre, 
 
 inline bool HashGrid::BallQuery::visits(const HashGrid& grid, std::uint32_t i) const {
   const Vec3f& p = grid.point(i);
-  if (!(d2_of(p) <= r2_)) return false;
+  if (!(d2_of(p, centre_) <= r2_)) return false;
   if (scan_all_) return true;
   // The cell the point was sorted into (build() bins it the same way).
   const double v[3] = {p.x, p.y, p.z};
@@ -180,12 +180,15 @@ inline bool HashGrid::BallQuery::visits(const HashGrid& grid, std::uint32_t i) c
 
 template <class Visit>
 void HashGrid::for_each_in_ball(const BallQuery& query, Visit&& visit) const {
+  // Locals, so that the scan keeps them in registers.
+  const Vec3 centre = query.centre_;
   const double r2 = query.r2_;
+  const Vec3f* const points = points_.data();
   const std::int64_t* lo = query.lo_;
   const std::int64_t* hi = query.hi_;
   if (query.scan_all_) {
     for (std::uint32_t i = 0; i < points_.size(); ++i) {
-      const double d2 = query.d2_of(points_[i]);
+      const double d2 = BallQuery::d2_of(points[i], centre);
       if (d2 <= r2) visit(i, d2);
     }
     return;
@@ -221,7 +224,7 @@ void HashGrid::for_each_in_ball(const BallQuery& query, Visit&& visit) const {
   const auto scan = [&] {
     for (std::size_t r = 0; r < ranges; ++r) {
       for (std::uint32_t i = range_begin[r]; i < range_end[r]; ++i) {
-        const double d2 = query.d2_of(points_[i]);
+        const double d2 = BallQuery::d2_of(points[i], centre);
         found[count] = i;
         found_d2[count] = d2;
         count += d2 <= r2;
@@ -250,7 +253,7 @@ void HashGrid::for_each_in_ball(const BallQuery& query, Visit&& visit) const {
           cells = start + run >= 64 ? 0 : cells & (~0ull << (start + run));
           range_begin[ranges] = cell_begin_[k];
           range_end[ranges] = cell_begin_[k + static_cast<std::size_t>(run)];
-          __builtin_prefetch(&points_[range_begin[ranges]]);
+          __builtin_prefetch(points + range_begin[ranges]);
           if (++ranges == std::size(range_begin)) scan();
         }
       }
