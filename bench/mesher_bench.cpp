@@ -168,7 +168,7 @@ void BM_GabrielWalk_NoisyTerrain200k(benchmark::State& state) {
   const g2s::HashGrid grid(terrain(), {});
   struct Edge {
     g2s::Vec3 a, b;
-    std::vector<g2s::Index> candidates;
+    std::vector<g2s::WalkPoint> candidates;
   };
   std::vector<Edge> edges;
   for (std::uint32_t i = 0; i < grid.size() && edges.size() < 20'000; i += 10) {
@@ -178,16 +178,17 @@ void BM_GabrielWalk_NoisyTerrain200k(benchmark::State& state) {
     const g2s::Vec3 mid = (e.a + e.b) * 0.5;
     grid.for_each_in_ball(mid, 2 * std::max(norm(e.b - e.a), grid.spacing()),
                           [&](std::uint32_t k, double) {
-                            if (k != i && k != j) e.candidates.push_back(k);
+                            const g2s::Vec3 q = grid.position(k);
+                            if (k != i && k != j) e.candidates.push_back({q, norm2(q - mid), k});
                           });
     if (!e.candidates.empty()) edges.push_back(std::move(e));
   }
-  std::vector<g2s::Index> scratch;
+  std::vector<g2s::WalkPoint> scratch;
   std::uint64_t walks = 0;
   for (auto _ : state) {
     for (const Edge& e : edges) {
       scratch.assign(e.candidates.begin(), e.candidates.end());
-      benchmark::DoNotOptimize(g2s::gabriel_walk(grid, e.a, e.b, (e.a + e.b) * 0.5, scratch));
+      benchmark::DoNotOptimize(g2s::gabriel_walk(e.a, e.b, scratch));
     }
     walks += edges.size();
   }

@@ -133,6 +133,14 @@ void expect_ball_matches(const HashGrid& grid, const Vec3& c, double radius,
   const std::vector<std::uint32_t> want = brute_ball(grid, c, radius);
   ASSERT_EQ(got, want) << what << " centre (" << c.x << ", " << c.y << ", " << c.z << ") radius "
                        << radius;
+  // BallQuery::visits answers the same for every point.
+  const HashGrid::BallQuery query(grid, c, radius);
+  std::size_t k = 0;
+  for (std::uint32_t i = 0; i < grid.size(); ++i) {
+    const bool in = k < got.size() && got[k] == i;
+    k += in;
+    ASSERT_EQ(query.visits(grid, i), in) << what << ": point " << i;
+  }
 }
 
 struct Box {

@@ -48,6 +48,12 @@ class EdgeMap {
     }
   }
 
+  // Starts loading the line that find(u, v) will read.
+  void prefetch(Index u, Index v) const {
+    const Index lo = std::min(u, v);
+    if (lo < lines_.size()) __builtin_prefetch(&lines_[lo]);
+  }
+
   // Records a triangle on edge {u, v}: first triangle, or closes it with a second.
   void add(Index u, Index v, std::uint32_t triangle) {
     const Index lo = std::min(u, v), hi = std::max(u, v);

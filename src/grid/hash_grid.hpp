@@ -34,9 +34,32 @@ class HashGrid {
   double spacing() const { return spacing_; }  // mean nearest-neighbour distance (sampled)
   double cell_size() const { return cell_; }
 
+  // A ball query as for_each_in_ball answers it: the test and the cells it scans.
+  class BallQuery {
+   public:
+    BallQuery(const HashGrid& grid, const Vec3& centre, double radius);
+    // Exactly whether the query visits point i (and with which squared distance).
+    bool visits(const HashGrid& grid, std::uint32_t i) const;
+
+   private:
+    friend class HashGrid;
+    static double d2_of(const Vec3f& p, const Vec3& centre) {
+      const double dx = p.x - centre.x, dy = p.y - centre.y, dz = p.z - centre.z;
+      return dx * dx + dy * dy + dz * dz;
+    }
+    Vec3 centre_;
+    double r2_;
+    std::int64_t lo_[3], hi_[3];  // the cells' box
+    bool scan_all_;  // a ball spanning more cells than there are points: scan the points
+  };
+
   // Calls visit(i, squared distance) for every point within radius of centre.
   template <class Visit>
-  void for_each_in_ball(const Vec3& centre, double radius, Visit&& visit) const;
+  void for_each_in_ball(const Vec3& centre, double radius, Visit&& visit) const {
+    for_each_in_ball(BallQuery(*this, centre, radius), visit);
+  }
+  template <class Visit>
+  void for_each_in_ball(const BallQuery& query, Visit&& visit) const;
 
   // Nearest point to point i among those accepted by keep(j), within max_radius; kNoIndex if
   // none.
@@ -128,24 +151,44 @@ constexpr std::uint64_t block_slab(int axis, int lo, int hi) {
   return mask;
 }
 
-template <class Visit>
-void HashGrid::for_each_in_ball(const Vec3& centre, double radius, Visit&& visit) const {
-  const double r2 = radius * radius;
+inline HashGrid::BallQuery::BallQuery(const HashGrid& grid, const Vec3& centre, double radius)
+    : centre_(centre), r2_(radius * radius) {
   const double c[3] = {centre.x, centre.y, centre.z};
-  std::int64_t lo[3], hi[3];
   // A ball spanning more cells than there are points (far outliers, very uneven density) is
   // cheaper to answer by scanning the points than by probing mostly empty cells.
   double box_cells = 1;
   for (int a = 0; a < 3; ++a) {
-    lo[a] = clamped_coord(c[a] - radius, a);
-    hi[a] = clamped_coord(c[a] + radius, a);
-    box_cells *= static_cast<double>(hi[a] - lo[a] + 1);
+    lo_[a] = grid.clamped_coord(c[a] - radius, a);
+    hi_[a] = grid.clamped_coord(c[a] + radius, a);
+    box_cells *= static_cast<double>(hi_[a] - lo_[a] + 1);
   }
-  if (box_cells > static_cast<double>(points_.size())) {
+  scan_all_ = box_cells > static_cast<double>(grid.size());
+}
+
+inline bool HashGrid::BallQuery::visits(const HashGrid& grid, std::uint32_t i) const {
+  const Vec3f& p = grid.point(i);
+  if (!(d2_of(p, centre_) <= r2_)) return false;
+  if (scan_all_) return true;
+  // The cell the point was sorted into (build() bins it the same way).
+  const double v[3] = {p.x, p.y, p.z};
+  for (int a = 0; a < 3; ++a) {
+    const std::int64_t cell = grid.clamped_coord(v[a], a);
+    if (cell < lo_[a] || cell > hi_[a]) return false;
+  }
+  return true;
+}
+
+template <class Visit>
+void HashGrid::for_each_in_ball(const BallQuery& query, Visit&& visit) const {
+  // Locals, so that the scan keeps them in registers.
+  const Vec3 centre = query.centre_;
+  const double r2 = query.r2_;
+  const Vec3f* const points = points_.data();
+  const std::int64_t* lo = query.lo_;
+  const std::int64_t* hi = query.hi_;
+  if (query.scan_all_) {
     for (std::uint32_t i = 0; i < points_.size(); ++i) {
-      const Vec3f& p = points_[i];
-      const double dx = p.x - centre.x, dy = p.y - centre.y, dz = p.z - centre.z;
-      const double d2 = dx * dx + dy * dy + dz * dz;
+      const double d2 = BallQuery::d2_of(points[i], centre);
       if (d2 <= r2) visit(i, d2);
     }
     return;
@@ -174,6 +217,22 @@ void HashGrid::for_each_in_ball(const Vec3& centre, double radius, Visit&& visit
     for (std::size_t f = 0; f < count; ++f) visit(found[f], found_d2[f]);
     count = 0;
   };
+  // The point ranges to scan are collected first, their first points prefetched, and scanned
+  // after: the cache misses of a query's cells then overlap instead of following one another.
+  std::uint32_t range_begin[16], range_end[16];
+  std::size_t ranges = 0;
+  const auto scan = [&] {
+    for (std::size_t r = 0; r < ranges; ++r) {
+      for (std::uint32_t i = range_begin[r]; i < range_end[r]; ++i) {
+        const double d2 = BallQuery::d2_of(points[i], centre);
+        found[count] = i;
+        found_d2[count] = d2;
+        count += d2 <= r2;
+        if (count == std::size(found)) flush();
+      }
+    }
+    ranges = 0;
+  };
   // Block by block, the non-empty cells in the query's box come from the masks at once; cells
   // consecutive in Morton order have consecutive points, so each run of them is one range.
   for (std::int64_t bz = lo[2] >> 2; bz <= hi[2] >> 2; ++bz) {
@@ -192,21 +251,15 @@ void HashGrid::for_each_in_ball(const Vec3& centre, double radius, Visit&& visit
           const std::size_t k =
               block->first + bit_count(block->cells & ((std::uint64_t{1} << start) - 1));
           cells = start + run >= 64 ? 0 : cells & (~0ull << (start + run));
-          for (std::uint32_t i = cell_begin_[k],
-                             end = cell_begin_[k + static_cast<std::size_t>(run)];
-               i < end; ++i) {
-            const Vec3f& p = points_[i];
-            const double dx = p.x - centre.x, dy = p.y - centre.y, dz = p.z - centre.z;
-            const double d2 = dx * dx + dy * dy + dz * dz;
-            found[count] = i;
-            found_d2[count] = d2;
-            count += d2 <= r2;
-            if (count == std::size(found)) flush();
-          }
+          range_begin[ranges] = cell_begin_[k];
+          range_end[ranges] = cell_begin_[k + static_cast<std::size_t>(run)];
+          __builtin_prefetch(points + range_begin[ranges]);
+          if (++ranges == std::size(range_begin)) scan();
         }
       }
     }
   }
+  scan();
   flush();
 }
 

@@ -21,6 +21,17 @@ class BucketQueue {
 
   bool empty() const { return size_ == 0; }
 
+  // The item `ahead` places behind the next one to pop, if it is in the same level (nullptr
+  // otherwise): what the front will most likely process soon, for prefetching.
+  const Item* peek(std::size_t ahead) const {
+    for (std::size_t level = static_cast<std::size_t>(lowest_); level < fifos_.size(); ++level) {
+      const Fifo& f = fifos_[level];
+      if (f.head == f.items.size()) continue;
+      return f.head + ahead < f.items.size() ? &f.items[f.head + ahead] : nullptr;
+    }
+    return nullptr;
+  }
+
   // Pops the oldest item of the lowest non-empty level; returns that level.
   int pop(Item& out) {
     while (fifos_[static_cast<std::size_t>(lowest_)].head ==

@@ -10,50 +10,58 @@
 #include <vector>
 
 #include "common/vec3.hpp"
-#include "grid/hash_grid.hpp"
+#include "g2s/types.hpp"
 
 namespace g2s {
 
+// A candidate: its grid index, its position and its squared distance to the edge midpoint
+// (norm2(position - mid)), gathered once so that the walk's steps need not recompute them.
+struct WalkPoint {
+  Vec3 position;
+  double dist2;
+  Index index;
+};
+
 // Candidates on (or nearly on) the line ab are dropped from `candidates` as met; kNoIndex when
 // none is left.
-inline Index gabriel_walk(const HashGrid& grid, const Vec3& a, const Vec3& b, const Vec3& mid,
-                          std::vector<Index>& candidates) {
+inline Index gabriel_walk(const Vec3& a, const Vec3& b, std::vector<WalkPoint>& candidates) {
   // The candidate nearest the edge midpoint.
   const auto nearest = [&] {
-    Index start = kNoIndex;
-    double best = 0;
-    for (Index q : candidates) {
-      const double d2 = norm2(grid.position(q) - mid);
-      if (start == kNoIndex || d2 < best || (d2 == best && q < start)) start = q, best = d2;
+    const WalkPoint* start = &candidates.front();
+    for (const WalkPoint& q : candidates) {
+      if (q.dist2 < start->dist2 || (q.dist2 == start->dist2 && q.index < start->index)) {
+        start = &q;
+      }
     }
-    return start;
+    return *start;
   };
   if (candidates.empty()) return kNoIndex;
-  Index p = nearest();
+  WalkPoint p = nearest();
   for (std::size_t step = 0; step <= candidates.size(); ++step) {
     Ball ball;
-    if (!circumball(a, b, grid.position(p), ball)) {
+    if (!circumball(a, b, p.position, ball)) {
       // (Nearly) on the line ab: no triangle. Walk on among the others, from the nearest.
-      candidates.erase(std::find(candidates.begin(), candidates.end(), p));
+      candidates.erase(std::find_if(candidates.begin(), candidates.end(),
+                                    [&](const WalkPoint& q) { return q.index == p.index; }));
       if (candidates.empty()) return kNoIndex;
       p = nearest();
       continue;
     }
     const double tol = 1e-6 * ball.radius2;
-    Index next = kNoIndex;
+    const WalkPoint* next = nullptr;
     double deepest = 0;
-    for (Index q : candidates) {
-      if (q == p) continue;
-      const double depth = norm2(grid.position(q) - ball.centre) - ball.radius2;
-      const bool inside = depth < -tol || (depth <= tol && q < p);
-      if (inside && (next == kNoIndex || depth < deepest || (depth == deepest && q < next))) {
-        next = q, deepest = depth;
+    for (const WalkPoint& q : candidates) {
+      if (q.index == p.index) continue;
+      const double depth = norm2(q.position - ball.centre) - ball.radius2;
+      const bool inside = depth < -tol || (depth <= tol && q.index < p.index);
+      if (inside && (!next || depth < deepest || (depth == deepest && q.index < next->index))) {
+        next = &q, deepest = depth;
       }
     }
-    if (next == kNoIndex) return p;
-    p = next;
+    if (!next) return p.index;
+    p = *next;
   }
-  return p;
+  return p.index;
 }
 
 }  // namespace g2s
