@@ -44,10 +44,7 @@ struct CliRun {
   std::string err;     // stderr, or why the run failed
 };
 
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using g2s::test_support::file_bytes;
 
 // A 30 x 30 grid of points 0.125 apart, exact in binary, on the surface z = height(x, y).
 template <typename Height>
@@ -137,11 +134,12 @@ class BadInput : public ::testing::Test {
         kill(pid, SIGKILL);
         waitpid(pid, &status, 0);
         ADD_FAILURE() << "g2s did not finish within " << seconds << " s (hang?)";
-        return {-1, slurp(out_path), "timed out"};
+        return {-1, file_bytes(out_path), "timed out"};
       }
       usleep(2000);
     }
-    CliRun result{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out_path), slurp(err_path)};
+    CliRun result{WIFEXITED(status) ? WEXITSTATUS(status) : -1, file_bytes(out_path),
+                  file_bytes(err_path)};
     if (WIFSIGNALED(status)) result.err += fmt::format("\n[killed by signal {}]", WTERMSIG(status));
     return result;
   }
@@ -246,9 +244,9 @@ TEST_F(BadInput, BigEndianMeshesExactlyLikeLittleEndian) {
   ASSERT_EQ(from_le.exit_code, kOk) << from_le.err;
   const CliRun from_be = mesh(be, be_mesh);
   ASSERT_EQ(from_be.exit_code, kOk) << from_be.err;
-  const std::string le_bytes = slurp(le_mesh);
+  const std::string le_bytes = file_bytes(le_mesh);
   EXPECT_GT(g2s::read_mesh(le_mesh).triangles.size(), 1500u);
-  EXPECT_TRUE(le_bytes == slurp(be_mesh)) << "the two meshes differ";
+  EXPECT_TRUE(le_bytes == file_bytes(be_mesh)) << "the two meshes differ";
 }
 
 TEST_F(BadInput, VertexElementWithoutZ) {
@@ -385,7 +383,7 @@ TEST_F(BadInput, DuplicatePointsAreMerged) {
   ASSERT_EQ(r.exit_code, kOk) << r.err;
   EXPECT_NE(r.err.find("100 duplicate points merged"), std::string::npos) << r.err;
   EXPECT_EQ(json_number(r.out, "duplicates_merged"), 100.0) << r.out;
-  EXPECT_TRUE(slurp(out()) == slurp(distinct_mesh)) << "duplicates changed the mesh";
+  EXPECT_TRUE(file_bytes(out()) == file_bytes(distinct_mesh)) << "duplicates changed the mesh";
 }
 
 TEST_F(BadInput, DirectoryAsInput) {

@@ -59,10 +59,7 @@ void expect_error(F&& f, Exit code, std::initializer_list<std::string_view> part
   }
 }
 
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using g2s::test_support::file_bytes;
 
 // An octahedron (float-exact coordinates) with an unused point in front and one at the end,
 // plus a degenerate triangle.
@@ -107,7 +104,7 @@ TEST_F(IoStlWriter, BinaryRoundTrip) {
   const TestMesh m = octahedron(0.1);  // 0.1 shifts make the coordinates non-float-exact
   const fs::path path = dir_ / "mesh.stl";
   g2s::write_mesh(path, m.xyz, m.triangles, g2s::MeshFormat::stl_binary);
-  const std::string bytes = slurp(path);
+  const std::string bytes = file_bytes(path);
   ASSERT_EQ(bytes.size(), 84 + 50 * m.triangles.size());
   EXPECT_NE(bytes.substr(0, 5), "solid");
   std::uint32_t count = 0;
@@ -140,7 +137,7 @@ TEST_F(IoStlWriter, AsciiRoundTrip) {
   const TestMesh m = octahedron(1e-3);
   const fs::path path = dir_ / "mesh.stl";
   g2s::write_mesh(path, m.xyz, m.triangles, g2s::MeshFormat::stl_ascii);
-  const std::string text = slurp(path);
+  const std::string text = file_bytes(path);
   EXPECT_EQ(text.substr(0, 10), "solid g2s\n");
   EXPECT_EQ(text.substr(text.size() - 13), "endsolid g2s\n");
   EXPECT_NE(text.find("facet normal 0 0 0\n"), std::string::npos) << "degenerate facet";
@@ -184,7 +181,7 @@ TEST_F(IoPlyWriter, FloatMeshRoundTripWritesOnlyUsedVerticesInFirstUseOrder) {
   const TestMesh m = octahedron();
   const fs::path path = dir_ / "mesh.ply";
   g2s::write_mesh(path, m.xyz, m.triangles, g2s::MeshFormat::ply_binary);
-  const std::string bytes = slurp(path);
+  const std::string bytes = file_bytes(path);
   EXPECT_NE(bytes.find("format binary_little_endian 1.0\n"), std::string::npos);
   EXPECT_NE(bytes.find("element vertex 6\nproperty float x\n"), std::string::npos);
   EXPECT_NE(bytes.find("property list uchar uint vertex_indices\n"), std::string::npos);
@@ -203,7 +200,7 @@ TEST_F(IoPlyWriter, DoubleWhenFloatWouldLoseBits) {
   const TestMesh m = octahedron(4.2e6 + 0.1);  // georeferenced: float cannot hold these
   const fs::path path = dir_ / "geo.ply";
   g2s::write_mesh(path, m.xyz, m.triangles, g2s::MeshFormat::ply_binary);
-  EXPECT_NE(slurp(path).find("property double x\n"), std::string::npos);
+  EXPECT_NE(file_bytes(path).find("property double x\n"), std::string::npos);
   const g2s::IndexedMesh back = g2s::read_mesh(path);
   EXPECT_EQ(corners_of(back.xyz, back.triangles, false), corners_of(m.xyz, m.triangles, false));
 }
@@ -274,7 +271,7 @@ TEST_F(IoAtomicFile, AppearsOnlyAtCommit) {
   EXPECT_EQ(file.size(), 5u);
   EXPECT_FALSE(fs::exists(target));
   file.commit();
-  EXPECT_EQ(slurp(target), "hello");
+  EXPECT_EQ(file_bytes(target), "hello");
   EXPECT_FALSE(fs::exists(file.temporary()));
   EXPECT_EQ(entries(), std::vector<std::string>{"out.bin"});
 }
@@ -284,9 +281,9 @@ TEST_F(IoAtomicFile, ReplacesAnExistingFile) {
   std::ofstream(target) << "old content";
   g2s::AtomicFile file(target);
   file.write("new", 3);
-  EXPECT_EQ(slurp(target), "old content");
+  EXPECT_EQ(file_bytes(target), "old content");
   file.commit();
-  EXPECT_EQ(slurp(target), "new");
+  EXPECT_EQ(file_bytes(target), "new");
 }
 
 TEST_F(IoAtomicFile, WriteAtPatchesFlushedAndBufferedBytes) {
@@ -315,7 +312,7 @@ TEST_F(IoAtomicFile, WriteAtPatchesFlushedAndBufferedBytes) {
     EXPECT_THROW(file.write_at(expected.size() - 1, "ab", 2), g2s::Error);
     file.commit();
   }
-  EXPECT_EQ(slurp(target), expected);
+  EXPECT_EQ(file_bytes(target), expected);
 }
 
 TEST_F(IoAtomicFile, UncommittedFileRemovesItsTemporary) {

@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
 #include <iterator>
 #include <numbers>
 
@@ -16,10 +15,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string bytes_of(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using g2s::test_support::file_bytes;
 
 // A torus as an n x m grid of quads, two triangles each; group runs of lengths 1..997.
 struct GroupedMesh {
@@ -95,7 +91,7 @@ TEST(MeshStreamWriter, GivesTheBytesOfWriteMeshWithTheFlipsApplied) {
     g2s::write_mesh(expected, mesh.xyz, flipped, format);
     EXPECT_EQ(fs::file_size(streamed), fs::file_size(expected));
     if (format != g2s::MeshFormat::ply_binary) {
-      EXPECT_TRUE(bytes_of(streamed) == bytes_of(expected)) << "the files differ";
+      EXPECT_TRUE(file_bytes(streamed) == file_bytes(expected)) << "the files differ";
       continue;
     }
     // PLY numbers vertices in order of first use as streamed, before the flips: the same

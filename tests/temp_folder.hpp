@@ -1,11 +1,13 @@
 // Test support: a fresh folder per test (mkdtemp, so parallel tests never share one), removed
-// with everything in it when the test ends. Permissions a test took away (a read-only folder, an
-// unreadable file) are given back first, so the removal always works.
+// with everything in it when the test ends, and a file's bytes read whole. Permissions a test took
+// away (a read-only folder, an unreadable file) are given back first, so the removal always works.
 #pragma once
 
 #include <stdlib.h>
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <stdexcept>
 #include <string>
 
@@ -34,5 +36,11 @@ class TempFolder {
  private:
   std::filesystem::path path_;
 };
+
+// The bytes of a file (empty when it cannot be read).
+inline std::string file_bytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
 
 }  // namespace g2s::test_support

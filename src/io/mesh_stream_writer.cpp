@@ -13,6 +13,7 @@
 #include <tbb/parallel_for.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -110,9 +111,11 @@ constexpr std::uint64_t kBatchWindows = 16;
 void flip_facets(AtomicFile& stl, std::span<const std::array<std::uint64_t, 2>> ranges,
                  std::uint64_t window) {
   std::vector<char> bytes;
-  for (const auto& [lo, hi] : ranges) {
-    const std::uint64_t first = std::max(lo, window), last = std::min(hi, window + kWindowFacets);
-    if (first >= last) continue;
+  const auto start = std::partition_point(ranges.begin(), ranges.end(),
+                                          [&](const auto& r) { return r[1] <= window; });
+  for (auto range = start; range != ranges.end() && (*range)[0] < window + kWindowFacets; ++range) {
+    const std::uint64_t first = std::max((*range)[0], window);
+    const std::uint64_t last = std::min((*range)[1], window + kWindowFacets);
     bytes.resize((last - first) * kStlRecordBytes);
     const std::uint64_t offset = kStlHeaderBytes + first * kStlRecordBytes;
     stl.read_at(offset, bytes.data(), bytes.size());
