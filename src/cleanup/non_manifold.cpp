@@ -29,17 +29,25 @@ NonManifoldReport mark_non_manifold_fans(std::span<const Triangle> triangles,
   const std::size_t nt = triangles.size();
   dead.assign(nt, 0);
   if (suspects.empty()) return report;
-  // CSR: vertex -> incident triangles.
+  // CSR: vertex -> incident triangles, each with its two other corners, so that walking a star
+  // reads one contiguous range instead of every triangle at random.
+  struct Corner {
+    std::uint32_t triangle;
+    Index u, w;  // the triangle's other corners, in the triangle's order
+  };
   std::vector<std::uint32_t> start(vertex_count + 1, 0);
   for (const Triangle& t : triangles) {
     for (Index v : t) ++start[v + 1];
   }
   std::partial_sum(start.begin(), start.end(), start.begin());
-  std::vector<std::uint32_t> star(start.back());
+  std::vector<Corner> star(start.back());
   {
     std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
     for (std::uint32_t t = 0; t < nt; ++t) {
-      for (Index v : triangles[t]) star[fill[v]++] = t;
+      const Triangle& c = triangles[t];
+      star[fill[c[0]]++] = {t, c[1], c[2]};
+      star[fill[c[1]]++] = {t, c[0], c[2]};
+      star[fill[c[2]]++] = {t, c[0], c[1]};
     }
   }
   // Suspects are examined in index order whatever order they arose in.
@@ -50,7 +58,8 @@ NonManifoldReport mark_non_manifold_fans(std::span<const Triangle> triangles,
   for (Index v : work) queued[v] = 1;
 
   // Scratch for one star.
-  std::vector<std::uint32_t> tris, parent, size;
+  std::vector<Corner> tris;
+  std::vector<std::uint32_t> parent, size;
   std::vector<std::pair<Index, std::uint32_t>> spokes;  // (other corner, local triangle)
   std::vector<std::uint8_t> open;
 
@@ -60,7 +69,7 @@ NonManifoldReport mark_non_manifold_fans(std::span<const Triangle> triangles,
     queued[v] = 0;
     tris.clear();
     for (std::uint32_t k = start[v]; k < start[v + 1]; ++k) {
-      if (!dead[star[k]]) tris.push_back(star[k]);
+      if (!dead[star[k].triangle]) tris.push_back(star[k]);
     }
     if (tris.size() < 2) continue;
     const auto m = static_cast<std::uint32_t>(tris.size());
@@ -68,9 +77,8 @@ NonManifoldReport mark_non_manifold_fans(std::span<const Triangle> triangles,
     std::iota(parent.begin(), parent.end(), 0u);
     spokes.clear();
     for (std::uint32_t l = 0; l < m; ++l) {
-      for (Index w : triangles[tris[l]]) {
-        if (w != v) spokes.push_back({w, l});
-      }
+      spokes.push_back({tris[l].u, l});
+      spokes.push_back({tris[l].w, l});
     }
     std::sort(spokes.begin(), spokes.end());
     for (std::size_t k = 0; k + 1 < spokes.size(); ++k) {
@@ -101,10 +109,10 @@ NonManifoldReport mark_non_manifold_fans(std::span<const Triangle> triangles,
     ++report.vertices_fixed;
     for (std::uint32_t l = 0; l < m; ++l) {
       if (find_root(parent, l) == keep) continue;
-      dead[tris[l]] = 1;
+      dead[tris[l].triangle] = 1;
       ++report.triangles_removed;
-      for (Index w : triangles[tris[l]]) {
-        if (w == v || queued[w]) continue;
+      for (Index w : {tris[l].u, tris[l].w}) {
+        if (queued[w]) continue;
         queued[w] = 1;
         if (finished.empty() || finished[w] == 1) {
           work.push_back(w);

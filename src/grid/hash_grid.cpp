@@ -118,9 +118,11 @@ void HashGrid::build(std::span<const float> xyz, std::span<const Index> ids, dou
 
   points_.clear();
   ids_.clear();
+  sources_.clear();
   cell_begin_.clear();
   points_.reserve(n);
   ids_.reserve(n);
+  sources_.reserve(n);
   std::vector<std::uint64_t> cell_codes;
   duplicates_ = 0;
   // Within a cell: order by coordinates, then id, so the result does not depend on input order
@@ -139,6 +141,7 @@ void HashGrid::build(std::span<const float> xyz, std::span<const Index> ids, dou
       }
       points_.push_back({xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]});
       ids_.push_back(id_of(i));
+      sources_.push_back(i);
     }
     begin = end;
   }

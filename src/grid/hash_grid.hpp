@@ -29,6 +29,8 @@ class HashGrid {
   const Vec3f& point(std::uint32_t i) const { return points_[i]; }
   Vec3 position(std::uint32_t i) const { return Vec3(points_[i]); }
   Index id(std::uint32_t i) const { return ids_[i]; }
+  // The point's index in the xyz the grid was built from.
+  std::uint32_t source(std::uint32_t i) const { return sources_[i]; }
   std::span<const Vec3f> points() const { return points_; }
   std::uint64_t duplicates_merged() const { return duplicates_; }
   double spacing() const { return spacing_; }  // mean nearest-neighbour distance (sampled)
@@ -95,6 +97,7 @@ class HashGrid {
 
   std::vector<Vec3f> points_;
   std::vector<Index> ids_;
+  std::vector<std::uint32_t> sources_;
   std::vector<std::uint32_t>
       cell_begin_;             // non-empty cells in Morton order, + 1: offsets into points_
   std::vector<Block> blocks_;  // open addressing, linear probing, load <= 1/2

@@ -106,11 +106,6 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
     const int a = static_cast<int>(k % 3);
     local[k] = static_cast<float>(points.xyz[k] - 0.5 * (box.lo[a] + box.hi[a]));
   }
-  // Global id -> index among the tile's points, for the grid's points that are the tile's own.
-  std::vector<std::pair<Index, std::uint32_t>> own_index(own);
-  for (std::uint32_t k = 0; k < own; ++k) own_index[k] = {points.ids[k], k};
-  std::sort(own_index.begin(), own_index.end());
-
   const HashGrid grid(local, points.ids);
   out.report.points = own;
   out.report.spacing = grid.spacing();
@@ -122,13 +117,13 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
   GrowResult grown = grow_mesh(grid, mesh_options);
   out.report.seeds = grown.seeds;
 
-  // Per grid point: its index among the tile's points, or kNoIndex for a halo point.
+  // Per grid point: its index among the tile's points (which come first), or kNoIndex for a
+  // halo point.
   std::vector<Index> point_of(grid.size(), kNoIndex);
   std::uint64_t mine_count = 0;
   for (std::uint32_t k = 0; k < grid.size(); ++k) {
-    const auto at = std::lower_bound(own_index.begin(), own_index.end(), std::pair{grid.id(k), 0u});
-    if (at != own_index.end() && at->first == grid.id(k)) {
-      point_of[k] = at->second;
+    if (grid.source(k) < own) {
+      point_of[k] = grid.source(k);
       ++mine_count;
     }
   }
