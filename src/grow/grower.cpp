@@ -65,7 +65,12 @@ class Grower {
         cos_max_fold_(std::cos(max_fold_)),
         radius_floor_(0.5 * grid.spacing()),
         radius_cap_(options.max_radius * grid.spacing()) {
-    triangles_.reserve(std::size_t{2} * grid.size());
+    // Noisy scans grow up to about three triangles a point before the clean-up; reserving more
+    // costs only address space (pages are touched as triangles come) and saves copying.
+    const std::size_t expected = std::size_t{4} * grid.size();
+    triangles_.reserve(expected);
+    group_.reserve(expected);
+    flip_.reserve(expected);
     // (Outside (0, pi], cos does not order the angles as needed: acos decides.)
     for (int k = 1; k <= flat_levels_ && max_fold_ > 0 && max_fold_ <= std::numbers::pi; ++k) {
       bound_cos_.push_back(std::cos(k * max_fold_ / flat_levels_));

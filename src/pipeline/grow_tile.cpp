@@ -131,6 +131,8 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
   out.report.duplicates_merged = own - mine_count;  // exact duplicates lie in one tile
   // Dense group numbers in order of first kept triangle: the same on every run.
   std::vector<std::uint32_t> dense(grown.triangles.size(), kNoIndex);
+  out.triangles.reserve(grown.triangles.size());
+  out.group.reserve(grown.triangles.size());
   for (std::size_t t = 0; t < grown.triangles.size(); ++t) {
     Triangle tri = grown.triangles[t];
     if (!mine(tri[0]) || !mine(tri[1]) || !mine(tri[2])) {
@@ -152,6 +154,10 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
     if (mine(v)) out.second_fans.push_back(point_of[v]);
   }
   out.report.triangles_grown = out.triangles.size();
+  // Everything is in `out` now: free the grower's arrays before the clean-up makes its own.
+  grown = GrowResult();
+  point_of = std::vector<Index>();
+  dense = std::vector<std::uint32_t>();
   clean_deep_fans(out, box, seam_depth(tiles, tile, options), halo_corners);
   put_final_first(out, box, seam_depth(tiles, tile, options, true));
   out.report.seconds_grow =
