@@ -312,6 +312,19 @@ TEST_F(TileStoreTest, DenseClusterGetsSmallerTiles) {
   EXPECT_LT(median(cluster_volumes) * 100, median(spread_volumes));
 }
 
+TEST_F(TileStoreTest, LastTileOfTheSweepIsSplitSmall) {
+  // Tiles grow in parallel in sweep order (store order), so the last one is grown while the
+  // other threads run out of work: it is split down to a quarter of the budget. A cloud that
+  // fits in one tile stays one tile.
+  const fs::path input = synthetic("torus.ply", g2s::SynthShape::torus, 100'000);
+  const g2s::TileStore store(build(input, "t.tiles", 20'000, false));
+  ASSERT_GE(store.tiles().size(), 6u);
+  expect_partition(store, g2s::read_points(input), 20'000);
+  EXPECT_LE(store.tiles().back().points, 5'000u);
+  EXPECT_GT(store.tiles().back().points, 0u);
+  EXPECT_EQ(g2s::TileStore(build(input, "one.tiles", 200'000, false)).tiles().size(), 1u);
+}
+
 TEST_F(TileStoreTest, PointsOnTheOuterFacesGiveNoFlatTiles) {
   // The cube's points lie exactly on its faces: many share the largest coordinate. A tile cut
   // there would be a flat slab on the cloud's face, which its neighbour's border would miss.
@@ -334,9 +347,12 @@ TEST_F(TileStoreTest, LoadBorderIsExactlyThePointsWithinTheDistance) {
   for (const bool compress : {false, true}) {
     const g2s::TileStore store(build(input, compress ? "z.tiles" : "r.tiles", 120'000, compress));
     ASSERT_GE(store.tiles().size(), 4u);
+    // Several frames in most tiles (the last ones of the sweep are split smaller).
+    EXPECT_GE(std::count_if(store.tiles().begin(), store.tiles().end(),
+                            [](const g2s::TileInfo& info) { return info.points > 5 * 16384u; }),
+              3);
     for (std::size_t t = 0; t < store.tiles().size(); ++t) {
       const g2s::TileInfo& info = store.tiles()[t];
-      EXPECT_GT(info.points, 5 * 16384u);  // several frames
       const g2s::TilePoints all = store.load(t);
       const double s = info.spacing;
       ASSERT_GT(s, 0);

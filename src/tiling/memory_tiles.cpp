@@ -52,7 +52,9 @@ MemoryTiles::MemoryTiles(const PointCloud& cloud, std::uint64_t tile_points) : c
   for (std::size_t i = 0; i < cloud.size(); ++i) sample.add(&cloud.xyz[3 * i], i);
   tiling::TileTree tree(bounding_box(cloud));
   if (cloud.size() > 0) {
-    tree.split(0, sample, 1.0, static_cast<double>(std::max<std::uint64_t>(tile_points, 1)));
+    const double budget = static_cast<double>(std::max<std::uint64_t>(tile_points, 1));
+    tree.split(0, sample, 1.0, budget);
+    tree.taper(sample, 1.0, tiling::kLastTileShare * budget);
   }
   const std::vector<std::uint32_t> leaves =
       cloud.size() > 0 ? tree.leaves() : std::vector<std::uint32_t>{};

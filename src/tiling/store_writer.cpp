@@ -80,17 +80,20 @@ std::vector<std::uint64_t> split_into_tiles(const std::filesystem::path& input, 
                                             const PointSample& first_sample,
                                             const ReadReport& first, std::uint64_t budget) {
   const double sampled_target = static_cast<double>(budget) * kSampledTargetFraction;
+  const double smallest = kLastTileShare * static_cast<double>(budget);
   if (first_sample.holds_every_point()) {
     tree.split(0, first_sample, 1.0, static_cast<double>(budget));
+    tree.taper(first_sample, 1.0, smallest);
     std::vector<std::uint64_t> counts(tree.node_count(), 0);
     for (std::size_t i = 0; i < first_sample.size(); ++i) {
       ++counts[tree.leaf_of(first_sample.point(i))];
     }
     return counts;
   }
-  tree.split(0, first_sample,
-             static_cast<double>(first.points) / static_cast<double>(first_sample.size()),
-             sampled_target);
+  const double first_weight =
+      static_cast<double>(first.points) / static_cast<double>(first_sample.size());
+  tree.split(0, first_sample, first_weight, sampled_target);
+  tree.taper(first_sample, first_weight, smallest);
   for (;;) {
     const std::vector<std::uint64_t> counts = count_leaves(input, tree, first);
     std::vector<std::uint32_t> over;

@@ -107,6 +107,25 @@ void TileTree::split_range(std::uint32_t node, const PointSample& sample, std::u
   }
 }
 
+void TileTree::taper(const PointSample& sample, double weight, double smallest) {
+  std::vector<std::uint32_t> members;
+  for (;;) {
+    const std::vector<std::uint32_t> order = leaves();
+    if (order.size() < 2) return;  // a cloud that fits in one tile stays one
+    const std::uint32_t last = order.back();
+    members.clear();
+    for (std::uint32_t i = 0; i < sample.size(); ++i) {
+      if (leaf_of(sample.point(i)) == last) members.push_back(i);
+    }
+    const double estimate = static_cast<double>(members.size()) * weight;
+    if (!(estimate > smallest)) return;
+    // One cut: every cut leaves each side at most 7/8 of the points.
+    split_range(last, sample, members.data(), members.data() + members.size(), weight,
+                estimate * (kMinShare - 1) / kMinShare);
+    if (is_leaf(last)) return;  // its points all coincide
+  }
+}
+
 std::vector<std::uint32_t> TileTree::leaves() const {
   std::vector<std::uint32_t> out;
   for (std::uint32_t n = 0; n < nodes_.size(); ++n) {

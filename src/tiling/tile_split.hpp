@@ -49,6 +49,9 @@ class PointSample {
   std::vector<std::uint64_t> hashes_;
 };
 
+// The last tile of the sweep is split down to this share of the tile budget (TileTree::taper).
+constexpr double kLastTileShare = 0.25;
+
 // A k-d tree as flat arrays of nodes; node 0 is the root (the cloud's bounding box). A point p
 // goes to the right child when p[axis] >= split, so a leaf owns lo <= p < hi, and the leaves
 // on the cloud's upper faces own the points lying on them.
@@ -78,6 +81,13 @@ class TileTree {
   // what it holds is the band along the sweep front, not the interfaces a depth-first order
   // leaves open at every level of the tree (measured: 36% less peak memory on 40M points).
   std::vector<std::uint32_t> leaves() const;
+
+  // With more than one leaf: splits the last leaf of the sweep in two, and again the leaf then
+  // last, while it is estimated above `smallest` points (`sample`: points of the whole tree, each
+  // standing for `weight`). Tiles grow in parallel in sweep order and the last one started is grown
+  // alone at the end: a small last tile keeps every thread busy until the end (measured on the
+  // alpine photogrammetry: its last tile grew alone for 2.6 s of a 20 s run on 2 threads).
+  void taper(const PointSample& sample, double weight, double smallest);
 
  private:
   struct Node {
