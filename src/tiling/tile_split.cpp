@@ -108,15 +108,15 @@ void TileTree::split_range(std::uint32_t node, const PointSample& sample, std::u
 }
 
 void TileTree::taper(const PointSample& sample, double weight, double smallest) {
-  std::vector<std::uint32_t> members;
+  std::vector<std::uint32_t> members(sample.size());
+  std::iota(members.begin(), members.end(), 0u);
   for (;;) {
     const std::vector<std::uint32_t> order = leaves();
     if (order.size() < 2) return;  // a cloud that fits in one tile stays one
     const std::uint32_t last = order.back();
-    members.clear();
-    for (std::uint32_t i = 0; i < sample.size(); ++i) {
-      if (leaf_of(sample.point(i)) == last) members.push_back(i);
-    }
+    // The sweep orders leaves by their lower corners, so the children of the last leaf come
+    // after every other leaf: the new last leaf's points are among the old one's.
+    std::erase_if(members, [&](std::uint32_t i) { return leaf_of(sample.point(i)) != last; });
     const double estimate = static_cast<double>(members.size()) * weight;
     if (!(estimate > smallest)) return;
     // One cut: every cut leaves each side at most 7/8 of the points.
