@@ -152,6 +152,9 @@ void add_mesh_options(CLI::App& cmd, PipelineOptions& options) {
                  "gaps and scan borders, at a cost in speed on sparse or noisy regions")
       ->check(CLI::Range(1.0, 1000.0));
   cmd.add_flag(
+      "--keep-gaps", [&options](std::int64_t) { options.mesh.close_gaps = false; },
+      "Leave gaps of three open edges open after growth (the paper's G2S alone)");
+  cmd.add_flag(
       "--no-orient", [&options](std::int64_t) { options.mesh.orient = false; },
       "Keep each component's seed orientation instead of facing closed ones outward");
 }

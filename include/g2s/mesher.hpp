@@ -26,6 +26,9 @@ struct MeshOptions {
   double max_radius = 6.0;
   // Seed search ball radius, in nearest-neighbour edge lengths (§3).
   double seed_ball = 2.5;
+  // Once growth is over, close gaps of three open edges with a triangle where the Point-Edge
+  // Map and the fold limit allow it (docs/algorithm.md §3); off: the paper's G2S alone.
+  bool close_gaps = true;
   // Orient each closed component outward (open, mostly horizontal ones up; see
   // docs/algorithm.md §6).
   bool orient = true;

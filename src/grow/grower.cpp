@@ -59,6 +59,7 @@ class Grower {
         edges_(grid.size()),
         seed_tried_(grid.size(), 0),
         state_(grid.size(), 0),
+        stalled_at_(options.close_gaps ? kStallSlots * grid.size() : 0, kNoIndex),
         queue_(std::max(1, levels_ * flat_levels_)),
         last_priority_(std::max(1, levels_ * flat_levels_) - 1),
         max_fold_(options.max_fold_deg * std::numbers::pi / 180.0),
@@ -88,6 +89,7 @@ class Grower {
       ++result.seeds;
       drain();
     }
+    if (options_.close_gaps) close_three_edge_gaps();
     result.group.resize(triangles_.size());
     result.flip.resize(triangles_.size());
     for (std::size_t t = 0; t < triangles_.size(); ++t) {
@@ -221,6 +223,41 @@ class Grower {
     if (options_.progress && (t & 0xFFFF) == 0) options_.progress(used_count_, grid_.size());
   }
 
+  // Once no front is left: closes each gap of three open edges a-b, b-x, x-a with a triangle
+  // where the Point-Edge Map allows it and it folds from none of its three neighbours. The front
+  // left such a gap because each edge's Gabriel point was some other point that could not join;
+  // with growth over, closing it can no longer block a better triangle. Every edge still open
+  // left the queue stalled, and stall() listed it at both its points.
+  void close_three_edge_gaps() {
+    const auto stalled_at = [&](Index u) {
+      return std::span<const Index>(stalled_at_).subspan(std::size_t{u} * kStallSlots, kStallSlots);
+    };
+    for (Index a = 0; a < grid_.size(); ++a) {
+      if (!growable(a)) continue;
+      // Each gap once, from its smallest corner: the checks do not depend on the edge.
+      for (const Index b : stalled_at(a)) {
+        if (b == kNoIndex || b == kOverflow || b < a || !growable(b)) continue;
+        const std::span<const Index> at_b = stalled_at(b);
+        for (const Index x : stalled_at(a)) {
+          if (x == kNoIndex || x == kOverflow || x <= b) continue;
+          if (std::find(at_b.begin(), at_b.end(), x) == at_b.end()) continue;
+          close_gap(a, b, x);
+        }
+      }
+    }
+  }
+
+  // Closes the gap a-b, b-x, x-a (all open edges) from edge a-b if the triangle does not fold.
+  void close_gap(Index a, Index b, Index x) {
+    const std::uint32_t t = edges_.find(a, b);
+    if (t & EdgeMap::kClosed) return;  // a neighbour closed it after it stalled
+    if (!traverses(triangles_[t], a, b)) std::swap(a, b);
+    const Vec3 pa = grid_.position(a), pb = grid_.position(b);
+    const Vec3 n_new = normalized(cross(pa - pb, grid_.position(x) - pb));
+    if (flatness(std::clamp(dot(normal_of(t), n_new), -1.0, 1.0)) < 0) return;
+    try_add({a, b, t, kNoIndex}, x);
+  }
+
   // Processes front edges until the front is empty (ALGORITHM.md §5).
   void drain() {
     FrontEdge e;
@@ -242,6 +279,7 @@ class Grower {
         if (!interior(e.cand) && try_add(e, e.cand)) continue;
         if (retries_ > 0) {
           retry(e, e.cand);
+          stall(e);
           continue;
         }
       }
@@ -249,7 +287,10 @@ class Grower {
       // closes it. (Retrying with the next-best point was measured to give worse meshes: the
       // Gabriel point's ball is then no longer empty.)
       const Candidate c = find_candidate(e);
-      if (c.point == kNoIndex) continue;
+      if (c.point == kNoIndex) {
+        stall(e);
+        continue;
+      }
       int priority = c.priority;
       const std::uint32_t on_ap = used(c.point) ? edges_.find(e.a, c.point) : EdgeMap::kMissing;
       const std::uint32_t on_pb = used(c.point) ? edges_.find(c.point, e.b) : EdgeMap::kMissing;
@@ -262,7 +303,33 @@ class Grower {
         queue_.push(priority, {e.a, e.b, e.triangle, c.point});
         continue;
       }
-      if (!try_add(e, c.point, on_ap, on_pb) && retries_ > 0) retry(e, c.point);
+      if (!try_add(e, c.point, on_ap, on_pb)) {
+        if (retries_ > 0) retry(e, c.point);
+        stall(e);
+      }
+    }
+  }
+
+  // An edge leaving the queue without a triangle of its own: it stays open unless a neighbour
+  // closes it, and is listed at both its points for close_three_edge_gaps (a point with more
+  // such edges still open than slots is marked kOverflow and left out).
+  void stall(const FrontEdge& e) {
+    if (!options_.close_gaps) return;
+    for (const auto& [u, v] : {std::pair{e.a, e.b}, std::pair{e.b, e.a}}) {
+      Index* slots = &stalled_at_[std::size_t{u} * kStallSlots];
+      Index* free = std::find(slots, slots + kStallSlots, kNoIndex);
+      if (free == slots + kStallSlots && slots[0] != kOverflow) {
+        // Full: free the slots of edges a neighbour has closed since.
+        for (std::size_t k = 0; k < kStallSlots; ++k) {
+          if (edges_.find(u, slots[k]) & EdgeMap::kClosed) slots[k] = kNoIndex;
+        }
+        free = std::find(slots, slots + kStallSlots, kNoIndex);
+      }
+      if (free != slots + kStallSlots) {
+        *free = v;
+      } else {
+        std::fill_n(slots, kStallSlots, kOverflow);
+      }
     }
   }
 
@@ -493,6 +560,11 @@ class Grower {
   // that the interior test of every point a search ball holds is a single load.
   static constexpr std::uint32_t kUsed = 0x80000000u;
   std::vector<std::uint32_t> state_;
+  // Per point, the other ends of the edges at it that left the queue without a triangle
+  // (stall()), kStallSlots each; kNoIndex: free, kOverflow: too many.
+  static constexpr std::size_t kStallSlots = 4;
+  static constexpr Index kOverflow = kNoIndex - 1;
+  std::vector<Index> stalled_at_;
   std::uint64_t used_count_ = 0;
   BucketQueue<FrontEdge> queue_;
   const int last_priority_;

@@ -1,0 +1,97 @@
+// The grower's gap closing (src/grow/grower.cpp, close_three_edge_gaps) on a hand-made front:
+// three kept triangles around a triangular gap, with a context point in the gap that is every
+// gap edge's Gabriel point but may not join, so the front itself leaves the gap open.
+#include "grow/grower.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "grid/hash_grid.hpp"
+
+namespace {
+
+using g2s::Index;
+using g2s::Triangle;
+
+struct GapRun {
+  std::vector<Triangle> grown;  // in input indices
+  std::vector<std::uint8_t> flip;
+};
+
+// Points: the gap A B X (0-2), the outer corners of its three neighbours (3-5), the context
+// point D just above the gap's centre (6).
+GapRun grow_around_gap(bool close_gaps) {
+  // clang-format off
+  const std::vector<float> xyz{
+      0,     0,       0,       // A
+      1,     0,       0,       // B
+      0.5f,  0.866f,  0,       // X
+      0.5f,  -0.866f, 0,       // beyond A-B
+      1.5f,  0.866f,  0,       // beyond B-X
+      -0.5f, 0.866f,  0,       // beyond X-A
+      0.5f,  0.2887f, 0.05f};  // D
+  // clang-format on
+  const std::vector<Index> ids{0, 1, 2, 3, 4, 5, 6};
+  const g2s::HashGrid grid(xyz, ids);
+  std::array<Index, 7> at{};  // input index -> grid index
+  for (std::uint32_t k = 0; k < grid.size(); ++k) at[grid.id(k)] = k;
+  // Each neighbour faces +z and traverses its gap edge against the gap's A->B->X.
+  const std::vector<Triangle> preload{
+      {at[1], at[0], at[3]}, {at[2], at[1], at[4]}, {at[0], at[2], at[5]}};
+  const std::vector<std::uint32_t> labels{0, 0, 0};
+  std::vector<std::uint8_t> growable(grid.size(), 0);
+  for (Index v : {0, 1, 2}) growable[at[v]] = 1;  // the outer corners and D are context
+  g2s::MeshOptions options;
+  options.close_gaps = close_gaps;
+  g2s::GrowResult r = g2s::grow_mesh(grid, options, {preload, labels, growable, {}, 0});
+  GapRun run;
+  for (const Triangle& t : r.triangles) {
+    run.grown.push_back({grid.id(t[0]), grid.id(t[1]), grid.id(t[2])});
+  }
+  run.flip.assign(r.flip.begin() + static_cast<long>(preload.size()), r.flip.end());
+  return run;
+}
+
+// The same cyclic order as a -> b -> c.
+bool same_cycle(const Triangle& t, Index a, Index b, Index c) {
+  for (int k = 0; k < 3; ++k) {
+    if (t[k] == a && t[(k + 1) % 3] == b && t[(k + 2) % 3] == c) return true;
+  }
+  return false;
+}
+
+TEST(GapClosing, TheFrontLeavesTheGapWhenItsGabrielPointMayNotJoin) {
+  const GapRun run = grow_around_gap(false);
+  EXPECT_TRUE(run.grown.empty());
+}
+
+TEST(GapClosing, AThreeEdgeGapIsClosedFacingLikeItsNeighbours) {
+  const GapRun run = grow_around_gap(true);
+  ASSERT_EQ(run.grown.size(), 1u);
+  // Opposite to the neighbours' traversals B->A, X->B, A->X, once its flip is applied.
+  Triangle t = run.grown[0];
+  if (run.flip[0]) std::swap(t[1], t[2]);
+  EXPECT_TRUE(same_cycle(t, 0, 1, 2));
+}
+
+TEST(GapClosing, AGapIsNotClosedWhereItWouldFold) {
+  // A flat pyramid: three triangles around P, just above the centre of A B X, facing up. Its
+  // open edges A->B, B->X, X->A make a three-edge gap, but the triangle closing it would face
+  // down, a fold of nearly 180 degrees from each of them.
+  const std::vector<float> xyz{0, 0, 0, 1, 0, 0, 0.5f, 0.866f, 0, 0.5f, 0.2887f, 0.1f};
+  const std::vector<Index> ids{0, 1, 2, 3};
+  const g2s::HashGrid grid(xyz, ids);
+  std::array<Index, 4> at{};
+  for (std::uint32_t k = 0; k < grid.size(); ++k) at[grid.id(k)] = k;
+  const std::vector<Triangle> preload{
+      {at[0], at[1], at[3]}, {at[1], at[2], at[3]}, {at[2], at[0], at[3]}};
+  const std::vector<std::uint32_t> labels{0, 0, 0};
+  const g2s::GrowResult r = g2s::grow_mesh(grid, g2s::MeshOptions{}, {preload, labels, {}, {}, 0});
+  EXPECT_TRUE(r.triangles.empty());
+}
+
+}  // namespace
