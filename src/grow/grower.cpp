@@ -59,7 +59,6 @@ class Grower {
         edges_(grid.size()),
         seed_tried_(grid.size(), 0),
         state_(grid.size(), 0),
-        stalled_at_(options.close_gaps ? kStallSlots * grid.size() : 0, kNoIndex),
         queue_(std::max(1, levels_ * flat_levels_)),
         last_priority_(std::max(1, levels_ * flat_levels_) - 1),
         max_fold_(options.max_fold_deg * std::numbers::pi / 180.0),
@@ -227,35 +226,47 @@ class Grower {
   // where the Point-Edge Map allows it and it folds from none of its three neighbours. The front
   // left such a gap because each edge's Gabriel point was some other point that could not join;
   // with growth over, closing it can no longer block a better triangle. Every edge still open
-  // left the queue stalled, and stall() listed it at both its points.
+  // left the queue stalled (stall()).
   void close_three_edge_gaps() {
-    const auto stalled_at = [&](Index u) {
-      return std::span<const Index>(stalled_at_).subspan(std::size_t{u} * kStallSlots, kStallSlots);
-    };
-    for (Index a = 0; a < grid_.size(); ++a) {
-      if (!growable(a)) continue;
-      // Each gap once, from its smallest corner: the checks do not depend on the edge.
-      for (const Index b : stalled_at(a)) {
-        if (b == kNoIndex || b == kOverflow || b < a || !growable(b)) continue;
-        const std::span<const Index> at_b = stalled_at(b);
-        for (const Index x : stalled_at(a)) {
-          if (x == kNoIndex || x == kOverflow || x <= b) continue;
-          if (std::find(at_b.begin(), at_b.end(), x) == at_b.end()) continue;
-          close_gap(a, b, x);
-        }
+    // The stalled edges no neighbour has closed since: the open edges.
+    std::size_t open = 0;
+    for (std::size_t k = 0; k < stalled_.size(); ++k) {
+      if (k + 8 < stalled_.size()) edges_.prefetch(stalled_[k + 8].a, stalled_[k + 8].b);
+      if (edges_.find(stalled_[k].a, stalled_[k].b) == stalled_[k].triangle) {
+        stalled_[open++] = stalled_[k];
       }
     }
-  }
-
-  // Closes the gap a-b, b-x, x-a (all open edges) from edge a-b if the triangle does not fold.
-  void close_gap(Index a, Index b, Index x) {
-    const std::uint32_t t = edges_.find(a, b);
-    if (t & EdgeMap::kClosed) return;  // a neighbour closed it after it stalled
-    if (!traverses(triangles_[t], a, b)) std::swap(a, b);
-    const Vec3 pa = grid_.position(a), pb = grid_.position(b);
-    const Vec3 n_new = normalized(cross(pa - pb, grid_.position(x) - pb));
-    if (flatness(std::clamp(dot(normal_of(t), n_new), -1.0, 1.0)) < 0) return;
-    try_add({a, b, t, kNoIndex}, x);
+    stalled_.resize(open);
+    // Per point, the other ends of its open edges: offsets, then the ends.
+    std::vector<std::uint32_t> begin(std::size_t{grid_.size()} + 1, 0);
+    for (const FrontEdge& e : stalled_) ++begin[e.a + 1], ++begin[e.b + 1];
+    for (std::uint32_t i = 0; i < grid_.size(); ++i) begin[i + 1] += begin[i];
+    std::vector<Index> other(begin.back());
+    std::vector<std::uint32_t> next(begin.begin(), begin.end() - 1);
+    for (const FrontEdge& e : stalled_) {
+      other[next[e.a]++] = e.b;
+      other[next[e.b]++] = e.a;
+    }
+    const auto open_at = [&](Index u) {
+      return std::span<const Index>(other).subspan(begin[u], begin[u + 1] - begin[u]);
+    };
+    for (const FrontEdge& e : stalled_) {
+      if (!growable(e.a) || !growable(e.b)) continue;
+      const Index c = apex(triangles_[e.triangle], e.a, e.b);
+      const std::span<const Index> at_b = open_at(e.b);
+      for (const Index x : open_at(e.a)) {
+        // Each gap once, from the edge between its two smallest points: the checks do not
+        // depend on the edge.
+        if (x <= std::max(e.a, e.b) || x == c) continue;
+        if (std::find(at_b.begin(), at_b.end(), x) == at_b.end()) continue;
+        if (edges_.find(e.a, e.b) != e.triangle) break;  // closed by a gap closed before
+        const Vec3 a = grid_.position(e.a), b = grid_.position(e.b);
+        const Vec3 n_new = normalized(cross(a - b, grid_.position(x) - b));
+        if (flatness(std::clamp(dot(normal_of(e.triangle), n_new), -1.0, 1.0)) < 0) continue;
+        if (try_add(e, x)) break;
+      }
+    }
+    stalled_ = {};
   }
 
   // Processes front edges until the front is empty (ALGORITHM.md §5).
@@ -311,26 +322,9 @@ class Grower {
   }
 
   // An edge leaving the queue without a triangle of its own: it stays open unless a neighbour
-  // closes it, and is listed at both its points for close_three_edge_gaps (a point with more
-  // such edges still open than slots is marked kOverflow and left out).
+  // closes it, and close_three_edge_gaps looks at it.
   void stall(const FrontEdge& e) {
-    if (!options_.close_gaps) return;
-    for (const auto& [u, v] : {std::pair{e.a, e.b}, std::pair{e.b, e.a}}) {
-      Index* slots = &stalled_at_[std::size_t{u} * kStallSlots];
-      Index* free = std::find(slots, slots + kStallSlots, kNoIndex);
-      if (free == slots + kStallSlots && slots[0] != kOverflow) {
-        // Full: free the slots of edges a neighbour has closed since.
-        for (std::size_t k = 0; k < kStallSlots; ++k) {
-          if (edges_.find(u, slots[k]) & EdgeMap::kClosed) slots[k] = kNoIndex;
-        }
-        free = std::find(slots, slots + kStallSlots, kNoIndex);
-      }
-      if (free != slots + kStallSlots) {
-        *free = v;
-      } else {
-        std::fill_n(slots, kStallSlots, kOverflow);
-      }
-    }
+    if (options_.close_gaps) stalled_.push_back({e.a, e.b, e.triangle, kNoIndex});
   }
 
   // Stitching only: between two meshes that are already fixed, an edge whose Gabriel point
@@ -560,11 +554,7 @@ class Grower {
   // that the interior test of every point a search ball holds is a single load.
   static constexpr std::uint32_t kUsed = 0x80000000u;
   std::vector<std::uint32_t> state_;
-  // Per point, the other ends of the edges at it that left the queue without a triangle
-  // (stall()), kStallSlots each; kNoIndex: free, kOverflow: too many.
-  static constexpr std::size_t kStallSlots = 4;
-  static constexpr Index kOverflow = kNoIndex - 1;
-  std::vector<Index> stalled_at_;
+  std::vector<FrontEdge> stalled_;  // edges that left the queue without a triangle (stall())
   std::uint64_t used_count_ = 0;
   BucketQueue<FrontEdge> queue_;
   const int last_priority_;
