@@ -27,7 +27,8 @@ struct MeshOptions {
   // Seed search ball radius, in nearest-neighbour edge lengths (§3).
   double seed_ball = 2.5;
   // Once growth is over, close gaps of three open edges with a triangle where the Point-Edge
-  // Map and the fold limit allow it (docs/algorithm.md §3); off: the paper's G2S alone.
+  // Map, the orientation groups and the fold limit allow it (docs/algorithm.md §3); off: the
+  // paper's G2S alone.
   bool close_gaps = true;
   // Orient each closed component outward (open, mostly horizontal ones up; see
   // docs/algorithm.md §6).

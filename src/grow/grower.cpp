@@ -321,8 +321,8 @@ class Grower {
     }
   }
 
-  // An edge leaving the queue without a triangle of its own: it stays open unless a neighbour
-  // closes it, and close_three_edge_gaps looks at it.
+  // An edge leaving the queue without a triangle of its own (on a seam, the retries may still
+  // have given it one): close_three_edge_gaps looks at it if it is still open by then.
   void stall(const FrontEdge& e) {
     if (options_.close_gaps) stalled_.push_back({e.a, e.b, e.triangle, kNoIndex});
   }
