@@ -237,7 +237,7 @@ library. We preferred it to a Debian tool: the mesh viewers that can save a pict
 ParaView, Blender) are large installs that need an X server or xvfb to run offscreen, and each
 would need a script of its own to colour boundary and non-manifold edges as \`g2s stats\` defines
 them. Ours draws exactly the edges \`g2s stats\` counts, gives the same bytes for the same mesh,
-and is tested in the suite (\`tests/render_test.cpp\` reads its PNGs back with an independent
+and is tested in the suite (\`tests/render/render_test.cpp\` reads its PNGs back with an independent
 decoder). Shading is quantised to 64 levels so every picture fits a PNG palette: about 45 KB at
 480×360.
 
@@ -247,7 +247,7 @@ decoder). Shading is quantised to 64 levels so every picture fits a PNG palette:
   manifold by construction (the Point-Edge Map never gives an edge a third triangle); vertices are
   made manifold by the clean-up pass, which had to remove ${stat[noise-0.5,removed]} triangles at σ = 0.5 s
   and ${stat[outliers-20,removed]} with 20% outliers (${stat[clean,removed]} on the clean cloud).
-  \`tests/robustness_test.cpp\` keeps the two hardest cases so.
+  \`tests/data/robustness_test.cpp\` keeps the two hardest cases so.
 - **Noise.** G2S interpolates: every point stays a vertex where it was (coverage
   $(percent "${stat[noise-0.5,coverage]}") even at σ = 0.5 s), so the noise is in the surface, as the
   pictures show; nothing is smoothed. Up to σ = 0.2 s the mesh is hardly affected

@@ -26,7 +26,7 @@
 #include <vector>
 
 #include "g2s/io.hpp"
-#include "temp_folder.hpp"
+#include "support/temp_folder.hpp"
 
 namespace {
 

@@ -31,7 +31,7 @@
 #include "g2s/io.hpp"
 #include "g2s/synth.hpp"
 #include "io/readers.hpp"
-#include "temp_folder.hpp"
+#include "support/temp_folder.hpp"
 #include "tiling/xxhash64.hpp"
 
 namespace {

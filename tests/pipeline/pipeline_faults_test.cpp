@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "g2s/synth.hpp"
-#include "temp_folder.hpp"
+#include "support/temp_folder.hpp"
 
 namespace {
 

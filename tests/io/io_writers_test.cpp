@@ -25,7 +25,7 @@
 
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
-#include "temp_folder.hpp"
+#include "support/temp_folder.hpp"
 
 namespace {
 

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "grid/hash_grid.hpp"
-#include "run_with_deadline.hpp"
+#include "support/run_with_deadline.hpp"
 
 namespace {
 

@@ -9,7 +9,7 @@
 #include <numbers>
 
 #include "g2s/io.hpp"
-#include "temp_folder.hpp"
+#include "support/temp_folder.hpp"
 
 namespace {
 

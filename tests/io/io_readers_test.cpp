@@ -24,7 +24,7 @@
 #include "g2s/io.hpp"
 #include "io/mapped_file.hpp"
 #include "io/readers.hpp"
-#include "temp_folder.hpp"
+#include "support/temp_folder.hpp"
 
 namespace {
 

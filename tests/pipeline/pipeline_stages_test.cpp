@@ -18,7 +18,7 @@
 #include "g2s/pipeline.hpp"
 #include "g2s/stats.hpp"
 #include "g2s/synth.hpp"
-#include "temp_folder.hpp"
+#include "support/temp_folder.hpp"
 
 namespace {
 

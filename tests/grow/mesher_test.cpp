@@ -25,7 +25,7 @@
 
 #include "g2s/stats.hpp"
 #include "g2s/synth.hpp"
-#include "run_with_deadline.hpp"
+#include "support/run_with_deadline.hpp"
 
 namespace {
 
