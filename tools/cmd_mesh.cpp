@@ -8,8 +8,11 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <limits>
+#include <string_view>
 
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
@@ -32,14 +35,41 @@ struct MeshArgs {
   PipelineOptions options;
 };
 
-// A kept store is reused when it is newer than the input (a re-run after an interruption, or
-// with other mesh options); anything else re-tiles.
-bool reusable(const std::filesystem::path& store, const std::filesystem::path& input) {
+// A kept store is reused only when it was made from this input (path, size, time, content
+// fingerprint) with this tiling; an older or other store is rebuilt, with a note. A file there
+// that is no tile store at all is refused rather than overwritten.
+bool reusable(const std::filesystem::path& store, const std::filesystem::path& input,
+              std::uint64_t tile_points, bool quiet) {
   std::error_code error;
-  const auto store_time = std::filesystem::last_write_time(store, error);
-  if (error) return false;
-  const auto input_time = std::filesystem::last_write_time(input, error);
-  return !error && store_time >= input_time;
+  if (!std::filesystem::exists(store, error)) return false;
+  {
+    char magic[8] = {};
+    std::ifstream in(store, std::ios::binary);
+    in.read(magic, sizeof magic);
+    if (!std::filesystem::is_regular_file(store, error) || !in ||
+        std::string_view(magic, sizeof magic) != "G2STILES") {
+      throw Error(Exit::usage,
+                  fmt::format("--keep-store {}: the file there is not a g2s tile store; refusing "
+                              "to overwrite it (choose another path)",
+                              store.string()));
+    }
+  }
+  std::string why;
+  try {
+    const TileStore kept(store);
+    if (kept.origin() == store_origin(input, tile_points)) return true;
+    why = kept.origin().tile_points != tile_points
+              ? fmt::format("was cut with --tile-points {}, not {}", kept.origin().tile_points,
+                            tile_points)
+              : fmt::format("was made from another file or version of {}", input.string());
+  } catch (const Error& e) {
+    if (e.code() != Exit::bad_input) throw;
+    why = fmt::format("cannot be reused ({})", e.what());
+  }
+  if (!quiet) {
+    fmt::print(stderr, "g2s: note: --keep-store {} {}; tiling again\n", store.string(), why);
+  }
+  return false;
 }
 
 // What the reader left out, on stderr: the input was usable, but not all of it was used.
@@ -56,30 +86,16 @@ void print_input_notes(const std::string& input, const ReadReport& report) {
   }
 }
 
-// Each tile is meshed in float around its centre, so a tile far wider than its sampling (a
-// stray point far from a georeferenced scan stretches its tile) loses detail: warn when float's
-// step at the tile's half-width exceeds a tenth of its point spacing.
-void warn_if_local_frame_rounds(const std::string& input, const TileStore& store) {
-  for (const TileInfo& t : store.tiles()) {
-    double half_width = 0.0;
-    for (int a = 0; a < 3; ++a)
-      half_width = std::max(half_width, 0.5 * (t.box.hi[a] - t.box.lo[a]));
-    const double step = half_width * std::numeric_limits<float>::epsilon();
-    if (t.points > 1 && step > 0.1 * t.spacing) {
-      fmt::print(stderr,
-                 "g2s: warning: {}: the points of a tile spread {:.6g} from its centre, so the "
-                 "mesher's float coordinates step by {:.3g}, too coarse for the point spacing "
-                 "{:.3g}: points closer than that may have merged (a stray point far from the "
-                 "rest?)\n",
-                 input, half_width, step, t.spacing);
-      return;
-    }
-  }
-}
-
 void run_mesh(MeshArgs& args) {
   Progress progress(!args.out.quiet && !args.out.json);
-  RunFacts run{args.input, 0, 0, std::chrono::steady_clock::now()};
+  RunFacts run{args.input, 0, 0, std::chrono::steady_clock::now(), {}};
+  refuse_same_file({args.input}, args.out.output, "-o");
+  checked_mesh_format(args.out.output, args.out.ascii);
+  check_radius_steps(args.options.mesh.radius_steps);
+  if (!args.keep_store.empty()) {
+    refuse_same_file({args.input}, args.keep_store, "--keep-store");
+    refuse_same_file({args.keep_store}, args.out.output, "-o");
+  }
   std::unique_ptr<TemporaryPath> temporary;
   std::filesystem::path store_path = args.keep_store;
   if (store_path.empty()) {
@@ -88,48 +104,65 @@ void run_mesh(MeshArgs& args) {
         output.parent_path() /
         fmt::format(".{}.store-{}", output.filename().string(), static_cast<long>(getpid())));
     store_path = temporary->path();
+    run.output_written = [&temporary] { temporary.reset(); };
   }
   const std::uint64_t budget = args.memory > 0 ? args.memory : default_memory_budget();
   const MemoryPlan plan = plan_memory(budget, args.threads);
   args.out.memory = budget;
-  ReadReport read;
-  if (temporary || !reusable(store_path, args.input)) {
-    TileStoreOptions tiling;
-    tiling.tile_points = args.tile_points > 0 ? args.tile_points : plan.tile_points;
-    tiling.round_points = std::max(plan.round_points, tiling.tile_points);
-    tiling.compress = args.compress;
-    tiling.progress = [&](std::uint64_t done, std::uint64_t total) {
-      progress.stage("tiling", total ? static_cast<double>(done) / static_cast<double>(total) : 1);
+  const std::uint64_t tile_points = args.tile_points > 0 ? args.tile_points : plan.tile_points;
+  try {
+    ReadReport read;
+    if (temporary || !reusable(store_path, args.input, tile_points, args.out.quiet)) {
+      TileStoreOptions tiling;
+      tiling.tile_points = tile_points;
+      tiling.round_points = std::max(plan.round_points, tiling.tile_points);
+      tiling.compress = args.compress;
+      tiling.progress = [&](std::uint64_t done, std::uint64_t total) {
+        progress.stage("tiling",
+                       total ? static_cast<double>(done) / static_cast<double>(total) : 1);
+      };
+      read = build_tile_store(args.input, store_path, tiling).read;
+    }
+    const TileStore store(store_path);
+    if (read.format.empty()) read = store.input_report();
+    run.non_finite = read.non_finite;
+    run.ignored_bytes = read.ignored_bytes;
+    if (!args.out.quiet) print_input_notes(args.input, read);
+    args.options.threads = args.threads;
+    args.options.tiles_in_flight = plan.tiles_in_flight;
+    args.options.progress = [&](std::uint64_t done, std::uint64_t total) {
+      progress.stage("meshing", static_cast<double>(done) / static_cast<double>(total));
     };
-    read = build_tile_store(args.input, store_path, tiling).read;
-  }
-  const TileStore store(store_path);
-  if (read.format.empty()) read = store.input_report();
-  run.non_finite = read.non_finite;
-  run.ignored_bytes = read.ignored_bytes;
-  if (!args.out.quiet) print_input_notes(args.input, read);
-  args.options.threads = args.threads;
-  args.options.tiles_in_flight = plan.tiles_in_flight;
-  args.options.progress = [&](std::uint64_t done, std::uint64_t total) {
-    progress.stage("meshing", static_cast<double>(done) / static_cast<double>(total));
-  };
-  write_and_report(
-      store,
-      [&](MeshSink& sink) {
-        const PipelineSummary summary = mesh_tiles(store, args.options, sink);
-        progress.clear();
-        if (!args.out.quiet && summary.triangles > 0) {
-          warn_if_local_frame_rounds(args.input, store);
-          if (summary.report.duplicates_merged > 0) {
-            fmt::print(stderr,
-                       "g2s: note: {}: {} duplicate points merged (equal in the mesher's float "
-                       "coordinates)\n",
-                       args.input, summary.report.duplicates_merged);
+    write_and_report(
+        store,
+        [&](MeshSink& sink) {
+          const PipelineSummary summary = mesh_tiles(store, args.options, sink);
+          progress.clear();
+          if (!args.out.quiet && summary.triangles > 0) {
+            if (const std::string why = why_tile_too_wide(store); !why.empty()) {
+              fmt::print(stderr, "g2s: warning: {}: {}\n", args.input, why);
+            }
+            if (summary.report.duplicates_merged > 0) {
+              fmt::print(stderr,
+                         "g2s: note: {}: {} duplicate points merged (equal in the mesher's "
+                         "float coordinates)\n",
+                         args.input, summary.report.duplicates_merged);
+            }
           }
-        }
-        return summary;
-      },
-      args.out, run);
+          return summary;
+        },
+        args.out, run);
+  } catch (const Error& e) {
+    // The temporary store's name means nothing to the user: name what they typed.
+    if (!temporary) throw;
+    std::string message = e.what();
+    const std::string hidden = temporary->path().string();
+    for (std::size_t at; (at = message.find(hidden)) != std::string::npos;) {
+      message.replace(at, hidden.size(),
+                      fmt::format("the temporary tile store for {}", args.out.output));
+    }
+    throw Error(e.code(), message);
+  }
 }
 
 }  // namespace
@@ -138,19 +171,20 @@ void add_mesh_options(CLI::App& cmd, PipelineOptions& options) {
   cmd.add_option("--radius-steps", options.mesh.radius_steps,
                  "Search radius levels, in edge lengths, increasing (default 1 1.5 2 3); "
                  "more levels close more gaps in sparse regions, at some cost in speed")
-      ->expected(1, 16);
+      ->expected(1, 16)
+      ->check(finite_range(0.01, 1000.0));
   cmd.add_option("--flatness-levels", options.mesh.flatness_levels,
                  "Flatness levels m of the priority queue (default 4); more levels mesh flat "
                  "regions first more strictly")
-      ->check(CLI::Range(1, 64));
+      ->check(count_range(1, 64));
   cmd.add_option("--max-fold", options.mesh.max_fold_deg,
                  "Largest angle in degrees between neighbouring triangle normals (default 135); "
                  "lower it on noisy scans to avoid folds, raise it for very sharp edges")
-      ->check(CLI::Range(10.0, 179.0));
+      ->check(finite_range(10.0, 179.0));
   cmd.add_option("--max-radius", options.mesh.max_radius,
                  "Largest search ball, in sampling spacings (default 6); larger bridges wider "
                  "gaps and scan borders, at a cost in speed on sparse or noisy regions")
-      ->check(CLI::Range(1.0, 1000.0));
+      ->check(finite_range(1.0, 1000.0));
   cmd.add_flag(
       "--keep-gaps", [&options](std::int64_t) { options.mesh.close_gaps = false; },
       "Leave gaps of three open edges open after growth (the paper's G2S alone)");
@@ -161,7 +195,8 @@ void add_mesh_options(CLI::App& cmd, PipelineOptions& options) {
 
 void add_output_options(CLI::App& cmd, OutputArgs& out) {
   cmd.add_option("-o,--output", out.output,
-                 "Mesh to write: .stl (binary; --ascii for ASCII) or .ply (indexed binary)")
+                 "Mesh to write: .stl (binary; --ascii for ASCII) or .ply (indexed binary); "
+                 "other extensions are refused")
       ->required();
   cmd.add_flag("--ascii", out.ascii, "Write ASCII STL instead of binary");
   cmd.add_flag("-q,--quiet", out.quiet, "Print nothing on success");
@@ -177,19 +212,20 @@ void add_mesh_command(CLI::App& app) {
       ->required();
   add_output_options(*cmd, args->out);
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(count_range(0, kMostThreads));
   cmd->add_option("--memory", args->memory,
                   "Memory budget, e.g. 512M or 4G (default: half the machine's RAM): sets the "
                   "tile size and the tiles in flight; the peak resident memory stays below it")
-      ->transform(CLI::AsSizeValue(false));
+      ->transform(byte_size());
   cmd->add_option("--tile-points", args->tile_points,
                   "Largest number of points in a tile (default: from --memory, at most "
-                  "1048576): the cloud is cut into tiles grown in parallel and stitched at the "
-                  "seams")
-      ->check(CLI::PositiveNumber);
+                  "1048576; at least 500): the cloud is cut into tiles grown in parallel and "
+                  "stitched at the seams")
+      ->check(count_range(kFewestTilePoints, 0xFFFFFFFF));
   cmd->add_option("--keep-store", args->keep_store,
-                  "Keep the tile store at this path (reused by the next run while it is newer "
-                  "than the input) instead of a temporary beside the output");
+                  "Keep the tile store at this path instead of a temporary beside the output; "
+                  "the next run reuses it if it was made from the same input (path, size, "
+                  "time, content) with the same --tile-points, else tiles again");
   cmd->add_flag("--compress", args->compress, "zstd-compress the tile store");
   add_mesh_options(*cmd, args->options);
   cmd->callback([args] { run_mesh(*args); });

@@ -11,6 +11,7 @@
 #include <string>
 #include <system_error>
 
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
@@ -48,6 +49,8 @@ void run_render(const RenderArgs& args) {
     throw Error(
         Exit::usage,
         fmt::format("render: --view expects AZIMUTH,ELEVATION in degrees, not '{}'", args.view));
+  require_extension(args.output, ".png", "the picture");
+  refuse_same_file({args.mesh}, args.output, "-o");
   options.up_axis = args.up[0] - 'x';
   options.edge_width = args.edge_width;
   const IndexedMesh mesh = read_mesh(args.mesh);

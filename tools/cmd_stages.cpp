@@ -13,6 +13,7 @@
 #include <memory>
 #include <mutex>
 
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "g2s/error.hpp"
 #include "g2s/pipeline.hpp"
@@ -71,10 +72,18 @@ std::pair<std::size_t, std::size_t> tile_range(const std::string& text, std::siz
 }
 
 void run_grow(GrowArgs& args) {
+  check_radius_steps(args.options.mesh.radius_steps);
   const TileStore store(args.store);
   const std::uint64_t fingerprint = source_fingerprint(store);
+  const std::uint64_t options = options_fingerprint(args.options);
   const std::filesystem::path folder = growth_folder(args.store, args.grown);
-  std::filesystem::create_directories(folder);
+  std::error_code error;
+  std::filesystem::create_directories(folder, error);
+  if (error || !std::filesystem::is_directory(folder)) {
+    throw Error(Exit::write_failed,
+                fmt::format("{}: cannot make the folder for the grown tiles: {}", folder.string(),
+                            error ? error.message() : "a file is in the way"));
+  }
   const auto [first, end] = tile_range(args.tiles, store.tiles().size());
   std::unique_ptr<tbb::global_control> limit;
   if (args.threads > 0) {
@@ -92,16 +101,16 @@ void run_grow(GrowArgs& args) {
     bool sound = false;
     if (std::filesystem::exists(file)) {
       try {
-        read_tile_growth(file, tile, fingerprint);
+        read_tile_growth(file, tile, fingerprint, options);
         sound = true;
       } catch (const Error&) {
-        sound = false;  // corrupt or from another store: grow it again
+        sound = false;  // corrupt, from another store or other options: grow it again
       }
     }
     if (sound) {
       ++skipped;
     } else {
-      write_tile_growth(file, tile, fingerprint, grow_tile(store, t, args.options));
+      write_tile_growth(file, tile, fingerprint, options, grow_tile(store, t, args.options));
     }
     const std::lock_guard guard(lock);
     progress.stage("growing", static_cast<double>(++done) / static_cast<double>(end - first));
@@ -115,16 +124,19 @@ void run_grow(GrowArgs& args) {
 
 void run_stitch(StitchArgs& args) {
   Progress progress(!args.out.quiet && !args.out.json);
-  RunFacts facts{args.store, 0, 0, std::chrono::steady_clock::now()};
+  RunFacts facts{args.store, 0, 0, std::chrono::steady_clock::now(), {}};
+  check_radius_steps(args.options.mesh.radius_steps);
+  refuse_same_file({args.store}, args.out.output, "-o");
   const TileStore store(args.store);
   facts.non_finite = store.input_report().non_finite;
   const std::uint64_t fingerprint = source_fingerprint(store);
+  const std::uint64_t options = options_fingerprint(args.options);
   const std::filesystem::path folder = growth_folder(args.store, args.grown);
   const std::size_t tiles = store.tiles().size();
   // Every growth file is checked before anything is stitched: a missing or corrupt one fails
   // the run at once, not after minutes of stitching.
   for (std::size_t t = 0; t < tiles; ++t) {
-    read_tile_growth(growth_file(folder, t), static_cast<std::uint32_t>(t), fingerprint);
+    read_tile_growth(growth_file(folder, t), static_cast<std::uint32_t>(t), fingerprint, options);
   }
   write_and_report(
       store,
@@ -132,7 +144,7 @@ void run_stitch(StitchArgs& args) {
         Stitcher stitcher(store, args.options, sink);
         for (std::size_t t = 0; t < tiles; ++t) {
           stitcher.add(t, read_tile_growth(growth_file(folder, t), static_cast<std::uint32_t>(t),
-                                           fingerprint));
+                                           fingerprint, options));
           progress.stage("stitching", static_cast<double>(t + 1) / static_cast<double>(tiles));
         }
         progress.clear();
@@ -151,7 +163,7 @@ void add_stage_commands(CLI::App& app) {
   g->add_option("--tiles", grow->tiles, "Tiles to grow: A-B (inclusive) or A; default all");
   g->add_option("--grown", grow->grown, "Folder for the grown tiles (default STORE.grown)");
   g->add_option("--threads", grow->threads, "Worker threads (default: all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(count_range(0, kMostThreads));
   g->add_flag("-q,--quiet", grow->quiet, "Print nothing on success");
   add_mesh_options(*g, grow->options);
   g->callback([grow] { run_grow(*grow); });

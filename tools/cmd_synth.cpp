@@ -13,6 +13,7 @@
 #include <string>
 #include <system_error>
 
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
@@ -96,6 +97,8 @@ void run_perturb(const SynthArgs& args) {
 }
 
 void run_synth(const SynthArgs& args) {
+  require_extension(args.output, ".ply", "a synthetic cloud");
+  if (!args.from.empty()) refuse_same_file({args.from}, args.output, "-o");
   if (!args.from.empty()) {
     run_perturb(args);
     return;

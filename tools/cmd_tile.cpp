@@ -8,8 +8,10 @@
 #include <memory>
 #include <string>
 
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "g2s/tile_store.hpp"
+#include "json_writer.hpp"
 #include "progress.hpp"
 
 namespace g2s::cli {
@@ -28,28 +30,13 @@ struct TileInfoArgs {
   bool json = false;
 };
 
-// JSON string contents: paths may hold quotes and backslashes.
-std::string json_escape(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      out += fmt::format("\\u{:04x}", static_cast<int>(c));
-    } else {
-      out += c;
-    }
-  }
-  return out;
-}
-
 std::string box_json(const TileBox& b) {
   return fmt::format("{{\"lo\":[{},{},{}],\"hi\":[{},{},{}]}}", b.lo[0], b.lo[1], b.lo[2], b.hi[0],
                      b.hi[1], b.hi[2]);
 }
 
 void run_tile(TileArgs& args) {
+  refuse_same_file({args.input}, args.store, "the store");
   Progress progress(!args.quiet && !args.json);
   const auto t0 = std::chrono::steady_clock::now();
   progress.stage("tiling", 0);
@@ -62,13 +49,19 @@ void run_tile(TileArgs& args) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   progress.clear();
   if (args.json) {
-    fmt::print(
-        "{{\"input\":\"{}\",\"store\":\"{}\",\"format\":\"{}\",\"points\":{},\"non_finite\":{},"
-        "\"tiles\":{},\"tile_points\":{},\"compressed\":{},\"bytes\":{},\"seconds\":{:.3f},"
-        "\"peak_rss_mb\":{:.1f}}}\n",
-        json_escape(args.input), json_escape(args.store), r.read.format, r.read.points,
-        r.read.non_finite, r.tiles, args.options.tile_points, args.options.compress, r.bytes,
-        seconds, peak_rss_mb());
+    JsonObject json;
+    json.text("input", args.input)
+        .text("store", args.store)
+        .text("format", r.read.format)
+        .number("points", r.read.points)
+        .number("non_finite", r.read.non_finite)
+        .number("tiles", r.tiles)
+        .number("tile_points", args.options.tile_points)
+        .number("compressed", args.options.compress)
+        .number("bytes", r.bytes)
+        .fixed("seconds", seconds, 3)
+        .fixed("peak_rss_mb", peak_rss_mb(), 1);
+    fmt::print("{}\n", json.str());
     return;
   }
   if (args.quiet) return;
@@ -84,17 +77,28 @@ void run_tile_info(const TileInfoArgs& args) {
   const ReadReport& in = store.input_report();
   const TileBox& b = store.bounds();
   if (args.json) {
-    fmt::print(
-        "{{\"store\":\"{}\",\"points\":{},\"compressed\":{},\"bounds\":{},\"input\":{{\"format\":"
-        "\"{}\",\"declared\":{},\"points\":{},\"non_finite\":{}}},\"tiles\":[",
-        json_escape(args.store), store.point_count(), store.compressed(), box_json(b), in.format,
-        in.declared, in.points, in.non_finite);
+    JsonObject input;
+    input.text("format", in.format)
+        .number("declared", in.declared)
+        .number("points", in.points)
+        .number("non_finite", in.non_finite);
+    std::string tiles = "[";
     for (std::size_t t = 0; t < store.tiles().size(); ++t) {
       const TileInfo& info = store.tiles()[t];
-      fmt::print("{}{{\"points\":{},\"spacing\":{},\"box\":{}}}", t > 0 ? "," : "", info.points,
-                 info.spacing, box_json(info.box));
+      JsonObject tile;
+      tile.number("points", info.points)
+          .number("spacing", info.spacing)
+          .raw("box", box_json(info.box));
+      tiles += (t > 0 ? "," : "") + tile.str();
     }
-    fmt::print("]}}\n");
+    JsonObject json;
+    json.text("store", args.store)
+        .number("points", store.point_count())
+        .number("compressed", store.compressed())
+        .raw("bounds", box_json(b))
+        .raw("input", input.str())
+        .raw("tiles", tiles + "]");
+    fmt::print("{}\n", json.str());
     return;
   }
   fmt::print("store:      {}\n", args.store);
@@ -125,8 +129,9 @@ void add_tile_commands(CLI::App& app) {
   cmd->add_option("store", args->store, "Tile store to write (one file, written atomically)")
       ->required();
   cmd->add_option("--tile-points", args->options.tile_points,
-                  "Most points in a tile (default 1048576); dense regions get smaller tiles")
-      ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{0xFFFFFFFF}));
+                  "Most points in a tile (default 1048576, at least 500); dense regions get "
+                  "smaller tiles")
+      ->check(count_range(kFewestTilePoints, 0xFFFFFFFF));
   cmd->add_flag("--compress", args->options.compress,
                 "zstd-compress the blocks (in 16k-point frames, so borders load without the rest)");
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");

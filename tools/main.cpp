@@ -4,6 +4,7 @@
 
 #include <exception>
 
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
@@ -22,6 +23,7 @@ int main(int argc, char** argv) {
   // points).
   mallopt(M_MMAP_THRESHOLD, 1 << 20);
   app.require_subcommand(1);
+  app.failure_message(g2s::cli::failure_message);
   app.set_version_flag("--version", "g2s 0.1.0");
   g2s::cli::add_mesh_command(app);
   g2s::cli::add_stage_commands(app);

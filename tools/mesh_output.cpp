@@ -4,14 +4,19 @@
 #include "mesh_output.hpp"
 
 #include <fmt/core.h>
+#include <signal.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
+#include "cli_checks.hpp"
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
 #include "g2s/stats.hpp"
 #include "g2s/surface_check.hpp"
+#include "json_writer.hpp"
 #include "progress.hpp"
 
 namespace g2s::cli {
@@ -34,19 +39,44 @@ void warn_if_stl_rounds(const std::string& output, const MeshStreamWriter& write
   }
 }
 
-// Why a run gave no triangle: degenerate clouds by name, else too sparse.
-[[noreturn]] void throw_no_surface(const TileSource& source, const PipelineSummary& summary,
-                                   const RunFacts& facts) {
-  PointCloud cloud;
-  for (std::size_t t = 0; t < source.tiles().size(); ++t) {
-    const TilePoints points = source.load(t);
-    cloud.xyz.insert(cloud.xyz.end(), points.xyz.begin(), points.xyz.end());
+}  // namespace
+
+// Points farther from their tile's centre than float resolves at the tile's spacing: the mesher
+// (float around each tile's centre) merges them. A reason, or "".
+std::string why_tile_too_wide(const TileSource& source) {
+  for (const TileInfo& t : source.tiles()) {
+    double half_width = 0.0;
+    for (int a = 0; a < 3; ++a)
+      half_width = std::max(half_width, 0.5 * (t.box.hi[a] - t.box.lo[a]));
+    const double step = half_width * std::numeric_limits<float>::epsilon();
+    if (t.points > 1 && t.spacing > 0.0 && step > 0.1 * t.spacing) {
+      return fmt::format(
+          "the points of a tile spread {:.6g} from its centre, so the mesher's float coordinates "
+          "step by {:.3g}, too coarse for the point spacing {:.3g}: points closer than that "
+          "merge (a stray point far from the rest?)",
+          half_width, step, t.spacing);
+    }
   }
-  std::string why = why_no_surface(cloud);
-  if (why.empty()) {
-    why = fmt::format("no triangle found among {} points (too sparse for --max-radius?)",
-                      summary.report.points);
-  }
+  return "";
+}
+
+namespace {
+
+// Why the points of `source` cannot form a surface (none, one point, two, a line), or "". A
+// tile too wide for float precision is named first: it is the true reason then.
+std::string why_no_surface(const TileSource& source) {
+  const std::string why = g2s::why_no_surface(source.point_count(), [&source](const auto& visit) {
+    for (std::size_t t = 0; t < source.tiles().size(); ++t) {
+      const TilePoints points = source.load(t);
+      for (std::size_t i = 0; i < points.size(); ++i) visit(&points.xyz[3 * i]);
+    }
+  });
+  if (why.empty()) return why;
+  const std::string too_wide = why_tile_too_wide(source);
+  return too_wide.empty() ? why : too_wide;
+}
+
+[[noreturn]] void throw_no_surface(const std::string& why, const RunFacts& facts) {
   const std::string dropped =
       facts.non_finite > 0
           ? fmt::format(" ({} points with NaN or Inf coordinates dropped)", facts.non_finite)
@@ -55,15 +85,55 @@ void warn_if_stl_rounds(const std::string& output, const MeshStreamWriter& write
                                             facts.input, why, dropped));
 }
 
+// Why a run gave no triangle: the tiles' precision, else too sparse.
+[[noreturn]] void throw_no_triangle(const TileSource& source, const PipelineSummary& summary,
+                                    const RunFacts& facts) {
+  std::string why = why_tile_too_wide(source);
+  if (why.empty()) {
+    why = fmt::format("no triangle found among {} points (too sparse for --max-radius?)",
+                      summary.report.points);
+  }
+  throw_no_surface(why, facts);
+}
+
+// After the mesh is complete at its target, an interrupt must not claim that nothing was
+// written: from then on SIGINT and SIGTERM say that the file is complete and only its defect
+// summary is missing (exit 130 still: the run did not finish). Async-signal-safe: the message
+// is composed before the handler is installed.
+char g_written_message[4608];
+std::size_t g_written_length = 0;
+
+void on_signal_after_output(int) {
+  [[maybe_unused]] const ssize_t n = ::write(STDERR_FILENO, g_written_message, g_written_length);
+  ::_exit(static_cast<int>(Exit::interrupted));
+}
+
+void interrupt_keeps_output(const std::string& output) {
+  const std::string message = fmt::format(
+      "g2s: interrupted while measuring the mesh; {} is complete, its defects were not "
+      "measured\n",
+      output.substr(0, 4096));
+  g_written_length = message.copy(g_written_message, sizeof g_written_message);
+  struct sigaction action {};
+  action.sa_handler = on_signal_after_output;
+  sigemptyset(&action.sa_mask);
+  ::sigaction(SIGINT, &action, nullptr);
+  ::sigaction(SIGTERM, &action, nullptr);
+}
+
 }  // namespace
 
 void write_and_report(const TileSource& source,
                       const std::function<PipelineSummary(MeshSink&)>& run, const OutputArgs& args,
                       const RunFacts& facts) {
-  const MeshFormat format = mesh_format_for(args.output, args.ascii);
+  const MeshFormat format = checked_mesh_format(args.output, args.ascii);
+  // A degenerate cloud is refused before meshing: the mesher would make slivers of it.
+  if (const std::string why = why_no_surface(source); !why.empty()) throw_no_surface(why, facts);
   MeshStreamWriter writer(args.output, format);
   const PipelineSummary summary = run(writer);
-  if (summary.triangles == 0) throw_no_surface(source, summary, facts);
+  if (summary.triangles == 0) throw_no_triangle(source, summary, facts);
+  if (facts.output_written) facts.output_written();
+  interrupt_keeps_output(args.output);
   if (!args.quiet && format != MeshFormat::ply_binary) {
     warn_if_stl_rounds(args.output, writer, summary.report.spacing);
   }
@@ -78,21 +148,32 @@ void write_and_report(const TileSource& source,
   MeshStats stats;
   if (measure) stats = compute_stats(read_mesh(args.output));
   if (args.json) {
-    fmt::print(
-        "{{\"input\":\"{}\",\"output\":\"{}\",\"points\":{},\"non_finite\":{},\"ignored_bytes\":{},"
-        "\"duplicates_merged\":{},\"spacing\":{},\"seeds\":{},\"triangles\":{},\"vertices\":{},"
-        "\"triangles_removed\":{},\"tiles\":{},\"triangles_stitched\":{},"
-        "\"seam_triangles_dropped\":{},\"vertices_unjudged\":{},\"peak_live_points\":{},"
-        "\"seconds\":{:.3f},"
-        "\"seconds_grid\":{:.3f},\"seconds_grow\":{:.3f},\"seconds_stitch\":{:.3f},"
-        "\"seconds_cleanup\":{:.3f},\"ktriangles_per_second\":{:.1f},\"peak_rss_mb\":{:.1f}",
-        facts.input, args.output, r.points, facts.non_finite, facts.ignored_bytes,
-        r.duplicates_merged, r.spacing, r.seeds, triangles, summary.vertices, r.triangles_removed,
-        summary.tiles, summary.triangles_stitched, summary.seam_triangles_dropped,
-        summary.vertices_unjudged, summary.peak_live_points, seconds, r.seconds_grid,
-        r.seconds_grow, summary.seconds_stitch, r.seconds_cleanup, ktps, peak_mb);
-    if (measure) fmt::print(",\"stats\":{}", stats_to_json(stats));
-    fmt::print("}}\n");
+    JsonObject json;
+    json.text("input", facts.input)
+        .text("output", args.output)
+        .number("points", r.points)
+        .number("non_finite", facts.non_finite)
+        .number("ignored_bytes", facts.ignored_bytes)
+        .number("duplicates_merged", r.duplicates_merged)
+        .number("spacing", r.spacing)
+        .number("seeds", r.seeds)
+        .number("triangles", triangles)
+        .number("vertices", summary.vertices)
+        .number("triangles_removed", r.triangles_removed)
+        .number("tiles", summary.tiles)
+        .number("triangles_stitched", summary.triangles_stitched)
+        .number("seam_triangles_dropped", summary.seam_triangles_dropped)
+        .number("vertices_unjudged", summary.vertices_unjudged)
+        .number("peak_live_points", summary.peak_live_points)
+        .fixed("seconds", seconds, 3)
+        .fixed("seconds_grid", r.seconds_grid, 3)
+        .fixed("seconds_grow", r.seconds_grow, 3)
+        .fixed("seconds_stitch", summary.seconds_stitch, 3)
+        .fixed("seconds_cleanup", r.seconds_cleanup, 3)
+        .fixed("ktriangles_per_second", ktps, 1)
+        .fixed("peak_rss_mb", peak_mb, 1);
+    if (measure) json.raw("stats", stats_to_json(stats));
+    fmt::print("{}\n", json.str());
     return;
   }
   if (args.quiet) return;

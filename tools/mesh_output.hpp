@@ -27,6 +27,9 @@ struct RunFacts {
   std::uint64_t non_finite = 0;     // points the reader dropped
   std::uint64_t ignored_bytes = 0;  // after a PLY's declared vertices
   std::chrono::steady_clock::time_point start;
+  // Called once the mesh is complete at its target, before it is measured (the temporary tile
+  // store can go then); may be empty.
+  std::function<void()> output_written;
 };
 
 // Runs the pipeline (`run` feeds the sink it is given) into args.output, written atomically,
@@ -35,5 +38,9 @@ struct RunFacts {
 void write_and_report(const TileSource& source,
                       const std::function<PipelineSummary(MeshSink&)>& run, const OutputArgs& args,
                       const RunFacts& facts);
+
+// Why a tile's points are too far from its centre for the mesher's float coordinates at the
+// tile's spacing (a stray point far from the rest stretches its tile), or "".
+std::string why_tile_too_wide(const TileSource& source);
 
 }  // namespace g2s::cli

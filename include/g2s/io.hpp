@@ -79,7 +79,9 @@ class TemporaryPath {
 // written (flushed or still buffered); commit() flushes, closes (checking the result; no fsync)
 // and renames over the target; destroying an uncommitted file removes the temporary. All OS
 // failures throw Error(write_failed, "<target>: <what>: <strerror>"), e.g. missing or read-only
-// folder, disk full (ENOSPC) or file size limit (EFBIG).
+// folder, disk full (ENOSPC) or file size limit (EFBIG). A symbolic link is written through (the
+// file it names is replaced, the link stays); an existing target that is not a regular file
+// (device, FIFO, socket) throws Error(write_failed) and is left alone.
 class AtomicFile {
  public:
   explicit AtomicFile(const std::filesystem::path& target);
@@ -101,6 +103,7 @@ class AtomicFile {
  private:
   void flush_buffer();
   std::filesystem::path target_;
+  std::filesystem::path destination_;  // target_ with symbolic links followed
   std::filesystem::path temporary_;
   int fd_ = -1;
   std::vector<char> buffer_;

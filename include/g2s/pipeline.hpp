@@ -120,13 +120,19 @@ class Stitcher {
 // The tile store's identity for growth files: a hash of its tile table.
 std::uint64_t source_fingerprint(const TileSource& source);
 
+// The options that change the mesh, for growth files: a hash of the MeshOptions (radius steps,
+// flatness levels, max fold, max radius, seed ball, close_gaps, orient) and the halo, band and
+// retries. Progress callbacks and thread counts are left out.
+std::uint64_t options_fingerprint(const PipelineOptions& options);
+
 // Growth files, for `g2s grow` and `g2s stitch` in separate processes: written atomically, read
 // back exactly; a file for another tile or store, a truncated or corrupt one throws
-// Error(bad_input) naming the file and the fault.
+// Error(bad_input) naming the file and the fault; one grown with other options (another
+// `options` fingerprint) throws Error(usage).
 void write_tile_growth(const std::filesystem::path& file, std::uint32_t tile,
-                       std::uint64_t fingerprint, const TileGrowth& growth);
+                       std::uint64_t fingerprint, std::uint64_t options, const TileGrowth& growth);
 TileGrowth read_tile_growth(const std::filesystem::path& file, std::uint32_t tile,
-                            std::uint64_t fingerprint);
+                            std::uint64_t fingerprint, std::uint64_t options);
 
 // All stages in one process: grow_tile over every tile as TBB tasks (at most
 // options.tiles_in_flight grown and not yet stitched), stitched in order into `sink`.

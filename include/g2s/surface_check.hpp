@@ -2,6 +2,8 @@
 // nothing was written instead of producing an empty or sliver-only mesh (src/check/).
 #pragma once
 
+#include <cstdint>
+#include <functional>
 #include <string>
 
 #include "g2s/types.hpp"
@@ -11,11 +13,18 @@ namespace g2s {
 // Why the points of `cloud` cannot form any surface, or "" when they can. A surface needs three
 // distinct points that are not on one straight line; the answer names the case: no points, all
 // points the same, only two distinct points, all points on one line, or (as the mesher works in
-// float) a cloud wider than 1e38 along an axis. "On one line" allows
-// for float rounding (the mesher works in float): every point within 1e-6 of the cloud's length
-// of the line through two points about a diameter apart (found by two farthest-point sweeps).
-// Linear time; only the collinear case allocates (to count distinct points).
+// float) a cloud wider than 1e38 along an axis. "On one line" allows for float rounding (the
+// mesher works in float): every point within max(1e-6 of the cloud's length, 4 float steps of
+// its largest coordinate) of the line through two points about a diameter apart (found by two
+// farthest-point sweeps), all but one stray point allowed. Linear time; only the collinear
+// case allocates (to count distinct points).
 std::string why_no_surface(const PointCloud& cloud);
+
+// The same for `n` points visited by `each` (which calls its argument with every point's x, y,
+// z, in the same order each time; it is called up to seven times), e.g. a tile store's tiles
+// loaded one at a time.
+using PointVisitor = std::function<void(const std::function<void(const double*)>&)>;
+std::string why_no_surface(std::uint64_t n, const PointVisitor& each);
 
 // The part of that check a bounding box answers (the tile store asks it before writing): why
 // points in [lo, hi] are beyond float's range, or "".

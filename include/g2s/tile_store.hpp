@@ -53,6 +53,23 @@ struct TileStoreReport {
   std::uint64_t bytes = 0;  // size of the store file
 };
 
+// What a store was made from, so a kept store is reused only for the same input and tiling:
+// the input's size, modification time (ns), a content fingerprint (XXH64 of its first and last
+// MiB and its size: cheap however large the file), a hash of its absolute path, and the
+// tile_points option (the only option that changes which points share a tile).
+struct StoreOrigin {
+  std::uint64_t bytes = 0;
+  std::int64_t mtime_ns = 0;
+  std::uint64_t content = 0;
+  std::uint64_t path = 0;
+  std::uint64_t tile_points = 0;
+  bool operator==(const StoreOrigin&) const = default;
+};
+
+// The origin a store built now from `input` with `tile_points` would record. Throws
+// Error(bad_input) when the input cannot be opened or read.
+StoreOrigin store_origin(const std::filesystem::path& input, std::uint64_t tile_points);
+
 // Reads `input` (any format read_points accepts) in streaming passes with bounded memory and
 // writes the store atomically at `store` (temporary name, renamed when complete). Global ids
 // are the points' order among the finite points of the input, as read_points numbers them.
@@ -97,6 +114,7 @@ class TileStore final : public TileSource {
   std::span<const TileInfo> tiles() const override;
   const ReadReport& input_report() const;  // as build_tile_store saw the input
   bool compressed() const;                 // blocks are zstd frames (for g2s tile-info)
+  const StoreOrigin& origin() const;       // what it was made from
 
   // All points of a tile.
   TilePoints load(std::size_t tile) const override;

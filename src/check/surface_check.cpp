@@ -1,6 +1,7 @@
 // why_no_surface: the degenerate clouds no mesher can turn into a surface (issue 5, bad input
-// matrix): empty, one repeated point, two points, points on a line. Coplanar clouds are not
-// degenerate: a flat scan is a valid open surface.
+// matrix): empty, one repeated point, two points, points on a line (within float precision, and
+// also with one stray point off it). Coplanar clouds are not degenerate: a flat scan is a valid
+// open surface. The points are visited in passes, so a tile store is checked in bounded memory.
 #include "g2s/surface_check.hpp"
 
 #include <fmt/core.h>
@@ -8,6 +9,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
+#include <utility>
 #include <vector>
 
 namespace g2s {
@@ -18,29 +21,53 @@ using Point = std::array<double, 3>;
 // Widest extent along an axis that float (up to 3.4e38) holds with room to spare.
 constexpr double kWidestSpan = 1e38;
 
-Point point_at(const PointCloud& cloud, std::size_t i) {
-  return {cloud.xyz[3 * i], cloud.xyz[3 * i + 1], cloud.xyz[3 * i + 2]};
-}
-
 double distance2(const Point& a, const Point& b) {
   const double dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
   return dx * dx + dy * dy + dz * dz;
 }
 
-// The point farthest from `from` (the first of equals).
-std::size_t farthest_from(const PointCloud& cloud, const Point& from) {
-  std::size_t best = 0;
+Point to_point(const double* p) {
+  return {p[0], p[1], p[2]};
+}
+
+// The point farthest from `from` (the first of equals), leaving out `skip` when given.
+Point farthest_from(const PointVisitor& each, const Point& from, const Point* skip = nullptr) {
+  Point best = from;
   double best_d2 = -1.0;
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const double d2 = distance2(point_at(cloud, i), from);
-    if (d2 > best_d2) best = i, best_d2 = d2;
-  }
+  each([&](const double* xyz) {
+    const Point p = to_point(xyz);
+    if (skip != nullptr && p == *skip) return;
+    const double d2 = distance2(p, from);
+    if (d2 > best_d2) best = p, best_d2 = d2;
+  });
   return best;
 }
 
-std::size_t count_distinct(const PointCloud& cloud) {
-  std::vector<Point> points(cloud.size());
-  for (std::size_t i = 0; i < points.size(); ++i) points[i] = point_at(cloud, i);
+// How many points (but those equal to `skip`) lie farther than `tolerance` from the line
+// through a and b (a != b), counted up to 2, and the first of them; stops at the second.
+std::size_t count_off_line(const PointVisitor& each, const Point& a, const Point& b,
+                           double tolerance, Point& first_off, const Point* skip = nullptr) {
+  const double length = std::sqrt(distance2(a, b));
+  const Point axis{(b[0] - a[0]) / length, (b[1] - a[1]) / length, (b[2] - a[2]) / length};
+  std::size_t off_line = 0;
+  each([&](const double* xyz) {
+    if (off_line >= 2) return;
+    const Point p = to_point(xyz);
+    if (skip != nullptr && p == *skip) return;
+    const Point d{p[0] - a[0], p[1] - a[1], p[2] - a[2]};
+    const Point off{d[1] * axis[2] - d[2] * axis[1], d[2] * axis[0] - d[0] * axis[2],
+                    d[0] * axis[1] - d[1] * axis[0]};
+    if (off[0] * off[0] + off[1] * off[1] + off[2] * off[2] > tolerance * tolerance) {
+      if (off_line++ == 0) first_off = p;
+    }
+  });
+  return off_line;
+}
+
+std::size_t count_distinct(const PointVisitor& each, std::uint64_t n) {
+  std::vector<Point> points;
+  points.reserve(n);
+  each([&](const double* xyz) { points.push_back(to_point(xyz)); });
   std::sort(points.begin(), points.end());
   return static_cast<std::size_t>(std::unique(points.begin(), points.end()) - points.begin());
 }
@@ -62,45 +89,73 @@ std::string why_beyond_float(const double lo[3], const double hi[3]) {
 }
 
 std::string why_no_surface(const PointCloud& cloud) {
-  const std::size_t n = cloud.size();
+  return why_no_surface(cloud.size(), [&cloud](const std::function<void(const double*)>& visit) {
+    for (std::size_t i = 0; i < cloud.size(); ++i) visit(&cloud.xyz[3 * i]);
+  });
+}
+
+std::string why_no_surface(std::uint64_t n, const PointVisitor& each) {
   if (n == 0) return "the cloud has no points";
   double lo[3], hi[3];
   for (int axis = 0; axis < 3; ++axis) {
-    lo[axis] = hi[axis] = cloud.xyz[axis];
-    for (std::size_t i = 0; i < n; ++i) {
-      lo[axis] = std::min(lo[axis], cloud.xyz[3 * i + axis]);
-      hi[axis] = std::max(hi[axis], cloud.xyz[3 * i + axis]);
-    }
+    lo[axis] = std::numeric_limits<double>::infinity();
+    hi[axis] = -std::numeric_limits<double>::infinity();
   }
+  Point first{};
+  bool have_first = false;
+  each([&](const double* p) {
+    if (!have_first) first = to_point(p), have_first = true;
+    for (int axis = 0; axis < 3; ++axis) {
+      lo[axis] = std::min(lo[axis], p[axis]);
+      hi[axis] = std::max(hi[axis], p[axis]);
+    }
+  });
   if (std::string why = why_beyond_float(lo, hi); !why.empty()) return why;
   // Two sweeps of "farthest point" give two points nearly a diameter apart: the line through
-  // them is the only candidate for a line holding every point.
-  const Point a = point_at(cloud, farthest_from(cloud, point_at(cloud, 0)));
-  const Point b = point_at(cloud, farthest_from(cloud, a));
+  // them is the candidate for a line holding every point.
+  const Point a = farthest_from(each, first);
+  const Point b = farthest_from(each, a);
   const double length2 = distance2(a, b);
   if (length2 == 0.0) {
     return n == 1 ? "the cloud has a single point"
                   : fmt::format("all {} points are the same point", n);
   }
-  const double length = std::sqrt(length2);
-  const Point axis{(b[0] - a[0]) / length, (b[1] - a[1]) / length, (b[2] - a[2]) / length};
-  // Float keeps about 7 digits: points closer to the line than this are on it for the mesher.
-  const double tolerance = 1e-6 * length;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Point p = point_at(cloud, i);
-    const Point d{p[0] - a[0], p[1] - a[1], p[2] - a[2]};
-    const Point off{d[1] * axis[2] - d[2] * axis[1], d[2] * axis[0] - d[0] * axis[2],
-                    d[0] * axis[1] - d[1] * axis[0]};
-    if (off[0] * off[0] + off[1] * off[1] + off[2] * off[2] > tolerance * tolerance) return "";
+  // Float keeps about 7 digits, of the extent (the mesher works in float around a tile's
+  // centre) and of the coordinates (the input may have been float): points closer to the line
+  // than that are on it for the mesher.
+  double largest = 0.0;
+  for (int axis = 0; axis < 3; ++axis) {
+    largest = std::max({largest, std::abs(lo[axis]), std::abs(hi[axis])});
   }
-  const std::size_t distinct = count_distinct(cloud);
+  const double float_step = 4.0 * static_cast<double>(std::numeric_limits<float>::epsilon());
+  const double tolerance = std::max(1e-6 * std::sqrt(length2), float_step * largest);
+  std::string stray;
+  Point off{};
+  const std::size_t off_line = count_off_line(each, a, b, tolerance, off);
+  bool on_one_line = off_line <= 1;
+  if (off_line == 1) stray = fmt::format(" but the one at ({}, {}, {})", off[0], off[1], off[2]);
+  // A stray point may also be a or b itself: the line is then the one through the other and
+  // the point farthest from it, the stray point left out.
+  for (const auto& [end, out] : {std::pair{a, b}, std::pair{b, a}}) {
+    if (on_one_line) break;
+    const Point other = farthest_from(each, end, &out);
+    if (other == end) continue;
+    const double tolerance_without =
+        std::max(1e-6 * std::sqrt(distance2(end, other)), float_step * largest);
+    if (count_off_line(each, end, other, tolerance_without, off, &out) == 0) {
+      on_one_line = true;
+      stray = fmt::format(" but the one at ({}, {}, {})", out[0], out[1], out[2]);
+    }
+  }
+  if (!on_one_line) return "";
+  const std::size_t distinct = count_distinct(each, n);
   if (distinct == 2) {
     return fmt::format("the cloud has only 2 distinct points ({} in all)", n);
   }
   return fmt::format(
-      "all {} points ({} distinct) lie on one straight line (to within {:.3g}, a millionth of "
-      "their extent)",
-      n, distinct, tolerance);
+      "all {} points ({} distinct){} lie on one straight line (to within {:.3g}, float "
+      "precision)",
+      n, distinct, stray, tolerance);
 }
 
 }  // namespace g2s

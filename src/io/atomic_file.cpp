@@ -1,6 +1,9 @@
 // AtomicFile: output appears at its target only when complete. Writes go through a 1 MiB buffer
 // to ".NAME.tmp-<pid>-<n>" beside the target; commit() flushes, closes (checking the result, so
 // delayed write errors surface) and renames. No fsync: speed over surviving a power cut.
+// A target that is a symbolic link is written through: the file it names is replaced, the link
+// stays. An existing target that is not a regular file (a device such as /dev/null, a FIFO, a
+// socket) is refused: renaming over it would replace the node itself.
 #include <fcntl.h>
 #include <fmt/core.h>
 #include <sys/stat.h>
@@ -26,6 +29,21 @@ std::atomic<std::uint64_t> g_counter{0};
               fmt::format("{}: {}: {}", target.string(), what, std::strerror(err)));
 }
 
+// The file a chain of symbolic links ends at (`path` itself when it is no link); a dangling
+// link gives the path it points to, which is then created.
+std::filesystem::path follow_links(const std::filesystem::path& path) {
+  std::filesystem::path at = path;
+  for (int hop = 0; hop < 40; ++hop) {
+    struct stat st {};
+    if (::lstat(at.c_str(), &st) != 0 || !S_ISLNK(st.st_mode)) return at;
+    std::error_code ec;
+    const std::filesystem::path next = std::filesystem::read_symlink(at, ec);
+    if (ec) fail_write(path, "cannot read the symbolic link", ec.value());
+    at = next.is_absolute() ? next : at.parent_path() / next;
+  }
+  fail_write(path, "cannot write", ELOOP);
+}
+
 }  // namespace
 
 AtomicFile::AtomicFile(const std::filesystem::path& target) : target_(target) {
@@ -34,10 +52,18 @@ AtomicFile::AtomicFile(const std::filesystem::path& target) : target_(target) {
     throw Error(Exit::write_failed,
                 fmt::format("{}: not a file name (the path names a folder)", target_.string()));
   }
+  destination_ = follow_links(target_);
   struct stat st {};
-  if (::stat(target_.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
-    fail_write(target_, "cannot write", EISDIR);
-  temporary_ = target_.parent_path() /
+  if (::stat(destination_.c_str(), &st) == 0) {
+    if (S_ISDIR(st.st_mode)) fail_write(target_, "cannot write", EISDIR);
+    if (!S_ISREG(st.st_mode)) {
+      throw Error(Exit::write_failed,
+                  fmt::format("{}: not a regular file (a device, FIFO or socket); g2s writes "
+                              "its output only to regular files",
+                              target_.string()));
+    }
+  }
+  temporary_ = destination_.parent_path() /
                fmt::format(".{}.tmp-{}-{}", name, static_cast<long>(::getpid()), g_counter++);
   // Registered before it exists, so a signal arriving just after it appears still removes it.
   registry_slot_ = register_temporary(temporary_.c_str());
@@ -155,7 +181,7 @@ void AtomicFile::commit() {
   const int fd = fd_;
   fd_ = -1;
   if (::close(fd) != 0) fail_write(target_, "write failed", errno);
-  if (::rename(temporary_.c_str(), target_.c_str()) != 0)
+  if (::rename(temporary_.c_str(), destination_.c_str()) != 0)
     fail_write(target_, "cannot rename into place", errno);
   committed_ = true;
   unregister_temporary(registry_slot_);

@@ -20,12 +20,14 @@ namespace {
 
 constexpr char kMagic[8] = {'G', '2', 'S', 'G', 'R', 'O', 'W', '\0'};
 // 2: corners as indices into the tile's points; 3: the tile's own non-manifold clean-up counts
-// and its final triangles.
-constexpr std::uint32_t kVersion = 3;
+// and its final triangles; 4: the options fingerprint.
+constexpr std::uint32_t kVersion = 4;
 // magic, version, tile, fingerprint, triangles, groups, suspects, points, seeds, spacing,
-// duplicates, triangles removed, vertices fixed, final triangles, payload checksum, header
-// checksum. No timings: the same tile gives the same bytes.
-constexpr std::size_t kHeaderBytes = 8 + 4 + 4 + 8 * 13;
+// duplicates, triangles removed, vertices fixed, final triangles, options fingerprint, payload
+// checksum, header checksum. No timings: the same tile gives the same bytes.
+constexpr std::size_t kHeaderBytes = 8 + 4 + 4 + 8 * 14;
+constexpr std::size_t kOptionsAt = 104;
+constexpr std::size_t kPayloadChecksumAt = 112;
 
 }  // namespace
 
@@ -44,8 +46,28 @@ std::uint64_t source_fingerprint(const TileSource& source) {
   return tiling::xxhash64(bytes.data(), bytes.size());
 }
 
+std::uint64_t options_fingerprint(const PipelineOptions& options) {
+  std::vector<char> bytes;
+  auto put = [&](auto value) {
+    char buffer[8];
+    bytes.insert(bytes.end(), buffer, io::put_le(buffer, value));
+  };
+  const MeshOptions& mesh = options.mesh;
+  put(static_cast<std::uint64_t>(mesh.radius_steps.size()));
+  for (double step : mesh.radius_steps) put(step);
+  put(static_cast<std::uint64_t>(mesh.flatness_levels));
+  put(mesh.max_fold_deg);
+  put(mesh.max_radius);
+  put(mesh.seed_ball);
+  put(static_cast<std::uint64_t>(mesh.close_gaps) | static_cast<std::uint64_t>(mesh.orient) << 1);
+  put(options.halo_spacings);
+  put(options.band_spacings);
+  put(static_cast<std::uint64_t>(options.stitch_retries));
+  return tiling::xxhash64(bytes.data(), bytes.size());
+}
+
 void write_tile_growth(const std::filesystem::path& file, std::uint32_t tile,
-                       std::uint64_t fingerprint, const TileGrowth& growth) {
+                       std::uint64_t fingerprint, std::uint64_t options, const TileGrowth& growth) {
   std::vector<char> payload(16 * growth.triangles.size() + 4 * growth.second_fans.size());
   char* p = payload.data();
   for (const Triangle& t : growth.triangles) {
@@ -70,6 +92,7 @@ void write_tile_growth(const std::filesystem::path& file, std::uint32_t tile,
   h = io::put_le(h, growth.report.triangles_removed);
   h = io::put_le(h, growth.report.non_manifold_vertices_fixed);
   h = io::put_le(h, static_cast<std::uint64_t>(growth.final_triangles));
+  h = io::put_le(h, options);
   h = io::put_le(h, tiling::xxhash64(payload.data(), payload.size()));
   io::put_le(h, tiling::xxhash64(header, kHeaderBytes - 8));
 
@@ -80,7 +103,7 @@ void write_tile_growth(const std::filesystem::path& file, std::uint32_t tile,
 }
 
 TileGrowth read_tile_growth(const std::filesystem::path& file, std::uint32_t tile,
-                            std::uint64_t fingerprint) {
+                            std::uint64_t fingerprint, std::uint64_t options) {
   auto fail = [&](const std::string& what) {
     return Error(Exit::bad_input, fmt::format("{}: {}", file.string(), what));
   };
@@ -107,6 +130,13 @@ TileGrowth read_tile_growth(const std::filesystem::path& file, std::uint32_t til
   if (tiling::load_le<std::uint64_t>(h + 16) != fingerprint) {
     throw fail("grown from a different tile store (re-run g2s grow on this store)");
   }
+  if (tiling::load_le<std::uint64_t>(h + kOptionsAt) != options) {
+    throw Error(Exit::usage,
+                fmt::format("{}: grown with other mesh options than these (--radius-steps, "
+                            "--flatness-levels, --max-fold, --max-radius, --keep-gaps, "
+                            "--no-orient): give the options g2s grow was given, or grow again",
+                            file.string()));
+  }
   const auto triangles = tiling::load_le<std::uint64_t>(h + 24);
   const auto groups = tiling::load_le<std::uint64_t>(h + 32);
   const auto suspects = tiling::load_le<std::uint64_t>(h + 40);
@@ -118,7 +148,8 @@ TileGrowth read_tile_growth(const std::filesystem::path& file, std::uint32_t til
                     bytes.size() - kHeaderBytes, triangles, suspects));
   }
   const unsigned char* p = h + kHeaderBytes;
-  if (tiling::load_le<std::uint64_t>(h + 104) != tiling::xxhash64(p, bytes.size() - kHeaderBytes)) {
+  if (tiling::load_le<std::uint64_t>(h + kPayloadChecksumAt) !=
+      tiling::xxhash64(p, bytes.size() - kHeaderBytes)) {
     throw fail("triangle checksum mismatch (the file is corrupt)");
   }
   TileGrowth g;

@@ -17,7 +17,8 @@
 namespace g2s::tiling {
 
 inline constexpr char kMagic[8] = {'G', '2', 'S', 'T', 'I', 'L', 'E', 'S'};
-inline constexpr std::uint32_t kVersion = 1;
+// 1: no origin; 2: the input's identity and the tiling options (StoreOrigin) in the header.
+inline constexpr std::uint32_t kVersion = 2;
 inline constexpr std::uint32_t kFlagCompressed = 1;
 // Points per frame, the unit of compression and of checksums: load_border reads whole frames.
 inline constexpr std::uint32_t kFramePoints = 16384;
@@ -26,25 +27,30 @@ inline constexpr std::size_t kPointBytes = 3 * sizeof(double) + sizeof(std::uint
 
 // Header fields: byte offsets.
 namespace header {
-inline constexpr std::size_t magic = 0;               // char[8]
-inline constexpr std::size_t version = 8;             // u32
-inline constexpr std::size_t header_bytes = 12;       // u32, = kHeaderBytes
-inline constexpr std::size_t flags = 16;              // u32
-inline constexpr std::size_t frame_points = 20;       // u32
-inline constexpr std::size_t point_count = 24;        // u64
-inline constexpr std::size_t tile_count = 32;         // u64
-inline constexpr std::size_t bounds = 40;             // f64 lo[3], hi[3]
-inline constexpr std::size_t input_declared = 88;     // u64
-inline constexpr std::size_t input_points = 96;       // u64
-inline constexpr std::size_t input_non_finite = 104;  // u64
-inline constexpr std::size_t input_format = 112;      // char[16], zero-padded
-inline constexpr std::size_t table_offset = 128;      // u64
-inline constexpr std::size_t table_bytes = 136;       // u64
-inline constexpr std::size_t file_bytes = 144;        // u64
-inline constexpr std::size_t table_checksum = 152;    // u64, XXH64 of the tile table
-inline constexpr std::size_t header_checksum = 184;   // u64, XXH64 of bytes [0, 184)
+inline constexpr std::size_t magic = 0;                 // char[8]
+inline constexpr std::size_t version = 8;               // u32
+inline constexpr std::size_t header_bytes = 12;         // u32, = kHeaderBytes
+inline constexpr std::size_t flags = 16;                // u32
+inline constexpr std::size_t frame_points = 20;         // u32
+inline constexpr std::size_t point_count = 24;          // u64
+inline constexpr std::size_t tile_count = 32;           // u64
+inline constexpr std::size_t bounds = 40;               // f64 lo[3], hi[3]
+inline constexpr std::size_t input_declared = 88;       // u64
+inline constexpr std::size_t input_points = 96;         // u64
+inline constexpr std::size_t input_non_finite = 104;    // u64
+inline constexpr std::size_t input_format = 112;        // char[16], zero-padded
+inline constexpr std::size_t table_offset = 128;        // u64
+inline constexpr std::size_t table_bytes = 136;         // u64
+inline constexpr std::size_t file_bytes = 144;          // u64
+inline constexpr std::size_t table_checksum = 152;      // u64, XXH64 of the tile table
+inline constexpr std::size_t origin_bytes = 160;        // u64, the input's size
+inline constexpr std::size_t origin_mtime = 168;        // i64, its modification time, ns
+inline constexpr std::size_t origin_content = 176;      // u64, XXH64 of first MB, last MB, size
+inline constexpr std::size_t origin_path = 184;         // u64, XXH64 of its absolute path
+inline constexpr std::size_t origin_tile_points = 192;  // u64, the tile_points option
+inline constexpr std::size_t header_checksum = 248;     // u64, XXH64 of bytes [0, 248)
 }  // namespace header
-inline constexpr std::size_t kHeaderBytes = 192;
+inline constexpr std::size_t kHeaderBytes = 256;
 inline constexpr std::size_t kFormatChars = 16;
 
 // Tile table entry fields.

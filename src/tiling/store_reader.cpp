@@ -44,6 +44,7 @@ struct TileStore::Impl {
   std::uint64_t point_count = 0;
   TileBox bounds;
   ReadReport input;
+  StoreOrigin origin;
   std::vector<TileInfo> tiles;
   std::vector<std::uint64_t> block_offset;
   std::vector<std::uint64_t> block_bytes;
@@ -72,12 +73,17 @@ void TileStore::Impl::open() {
   if (std::memcmp(file.bytes(), kMagic, std::min(size, sizeof kMagic)) != 0) {
     fail("not a g2s tile store (it does not start with the magic bytes 'G2STILES')");
   }
+  const unsigned char* h = file.bytes();
+  if (size >= header::version + 4) {
+    const auto version = load_le<std::uint32_t>(h + header::version);
+    if (version != kVersion) {
+      fail("store version {}, this g2s reads {} (tile the cloud again with this g2s)", version,
+           kVersion);
+    }
+  }
   if (size < kHeaderBytes) {
     fail("truncated: {} bytes, shorter than the {}-byte header", size, kHeaderBytes);
   }
-  const unsigned char* h = file.bytes();
-  const auto version = load_le<std::uint32_t>(h + header::version);
-  if (version != kVersion) fail("store version {}, this g2s reads {}", version, kVersion);
   if (xxhash64(h, header::header_checksum) != load_le<std::uint64_t>(h + header::header_checksum)) {
     fail("header checksum mismatch (the header is corrupt)");
   }
@@ -108,6 +114,11 @@ void TileStore::Impl::open() {
   input.non_finite = load_le<std::uint64_t>(h + header::input_non_finite);
   const char* format = reinterpret_cast<const char*>(h + header::input_format);
   input.format.assign(format, strnlen(format, kFormatChars));
+  origin.bytes = load_le<std::uint64_t>(h + header::origin_bytes);
+  origin.mtime_ns = load_le<std::int64_t>(h + header::origin_mtime);
+  origin.content = load_le<std::uint64_t>(h + header::origin_content);
+  origin.path = load_le<std::uint64_t>(h + header::origin_path);
+  origin.tile_points = load_le<std::uint64_t>(h + header::origin_tile_points);
   const auto table_offset = load_le<std::uint64_t>(h + header::table_offset);
   const auto table_bytes = load_le<std::uint64_t>(h + header::table_bytes);
   if (table_offset != kHeaderBytes || tile_count > size / kEntryBytes ||
@@ -268,6 +279,9 @@ const TileBox& TileStore::bounds() const {
 }
 std::span<const TileInfo> TileStore::tiles() const {
   return impl_->tiles;
+}
+const StoreOrigin& TileStore::origin() const {
+  return impl_->origin;
 }
 const ReadReport& TileStore::input_report() const {
   return impl_->input;

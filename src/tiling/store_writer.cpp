@@ -7,6 +7,7 @@
 // order, sorted by a total order, and frames encoded in parallel but written in order, so the
 // bytes do not depend on threads or timing.
 #include <fmt/core.h>
+#include <sys/stat.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
@@ -231,6 +232,30 @@ BlockEntry write_block(AtomicFile& file, std::span<const double> xyz, std::span<
 
 }  // namespace
 
+StoreOrigin store_origin(const std::filesystem::path& input, std::uint64_t tile_points) {
+  const io::MappedFile file(input, io::MapMode::random);
+  StoreOrigin origin;
+  origin.bytes = file.size();
+  origin.tile_points = tile_points;
+  struct stat st {};
+  if (::stat(input.c_str(), &st) == 0) {
+    origin.mtime_ns = static_cast<std::int64_t>(st.st_mtim.tv_sec) * 1000000000 +
+                      static_cast<std::int64_t>(st.st_mtim.tv_nsec);
+  }
+  constexpr std::size_t kMiB = std::size_t{1} << 20;
+  const std::size_t head = std::min(file.size(), kMiB);
+  const std::size_t tail_begin = file.size() - std::min(file.size(), kMiB);
+  std::uint64_t parts[3] = {xxhash64(file.bytes(), head),
+                            xxhash64(file.bytes() + tail_begin, file.size() - tail_begin),
+                            file.size()};
+  origin.content = xxhash64(parts, sizeof parts);
+  file.release(0, file.size());
+  std::error_code ec;
+  const std::string absolute = std::filesystem::absolute(input, ec).lexically_normal().string();
+  origin.path = xxhash64(absolute.data(), absolute.size());
+  return origin;
+}
+
 TileStoreReport build_tile_store(const std::filesystem::path& input,
                                  const std::filesystem::path& store,
                                  const TileStoreOptions& options) {
@@ -244,6 +269,8 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
                             "pipe or device cannot be tiled)",
                             input.string()));
   }
+
+  const StoreOrigin origin = store_origin(input, options.tile_points);
 
   // Pass 1: bounding box and sample.
   TileBox bounds;
@@ -378,6 +405,11 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
   store_le(h + header::table_bytes, std::uint64_t{table.size()});
   store_le(h + header::file_bytes, file.size());
   store_le(h + header::table_checksum, xxhash64(table.data(), table.size()));
+  store_le(h + header::origin_bytes, origin.bytes);
+  store_le(h + header::origin_mtime, origin.mtime_ns);
+  store_le(h + header::origin_content, origin.content);
+  store_le(h + header::origin_path, origin.path);
+  store_le(h + header::origin_tile_points, origin.tile_points);
   store_le(h + header::header_checksum, xxhash64(h, header::header_checksum));
   file.write_at(0, header.data(), header.size());
   file.write_at(kHeaderBytes, table.data(), table.size());
