@@ -5,6 +5,7 @@
 #include <fmt/core.h>
 
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -53,7 +54,25 @@ void run_render(const RenderArgs& args) {
   refuse_same_file({args.mesh}, args.output, "-o");
   options.up_axis = args.up[0] - 'x';
   options.edge_width = args.edge_width;
-  const IndexedMesh mesh = read_mesh(args.mesh);
+  IndexedMesh mesh = read_mesh(args.mesh);
+  // A vertex at NaN or Inf would stretch the view to nothing: such triangles are left out.
+  const auto finite = [&mesh](Index v) {
+    return static_cast<std::size_t>(v) < mesh.vertex_count() && std::isfinite(mesh.xyz[3 * v]) &&
+           std::isfinite(mesh.xyz[3 * v + 1]) && std::isfinite(mesh.xyz[3 * v + 2]);
+  };
+  const std::size_t given = mesh.triangles.size();
+  std::erase_if(mesh.triangles, [&](const Triangle& t) {
+    return static_cast<std::size_t>(t[0]) < mesh.vertex_count() &&
+           static_cast<std::size_t>(t[1]) < mesh.vertex_count() &&
+           static_cast<std::size_t>(t[2]) < mesh.vertex_count() &&
+           !(finite(t[0]) && finite(t[1]) && finite(t[2]));
+  });
+  if (mesh.triangles.size() < given) {
+    fmt::print(stderr,
+               "g2s: warning: {}: {} of {} triangles have a vertex at NaN or Inf; drawn without "
+               "them\n",
+               args.mesh, given - mesh.triangles.size(), given);
+  }
   RenderReport report;
   const Image image = render_mesh(mesh, options, &report);
   write_png(args.output, image);

@@ -1,5 +1,6 @@
 // MappedFile: maps an input file read-only (MAP_POPULATE, sequential advice) so the readers can
-// parse it in place; falls back to read() for files whose size stat does not know. Every OS
+// parse it in place; falls back to read() for files whose size stat does not know (/proc).
+// Devices, FIFOs and sockets are refused: they may never end. Every OS
 // failure becomes Error(bad_input, "<file>: <what>: <strerror>").
 #include "io/mapped_file.hpp"
 
@@ -42,6 +43,13 @@ MappedFile::MappedFile(const std::filesystem::path& path, MapMode mode)
   if (S_ISDIR(st.st_mode)) {
     throw Error(Exit::bad_input, fmt::format("{}: is a directory, expected a file", name_));
   }
+  // A device or FIFO may never end (/dev/zero, a pipe from `yes`): reading it whole would fill
+  // the memory, so only regular files are read.
+  if (!S_ISREG(st.st_mode)) {
+    throw Error(
+        Exit::bad_input,
+        fmt::format("{}: not a regular file (a device, FIFO or socket); give a file", name_));
+  }
   if (S_ISREG(st.st_mode) && st.st_size > 0) {
     size_ = static_cast<std::size_t>(st.st_size);
     const int populate = mode == MapMode::whole ? MAP_POPULATE : 0;
@@ -52,7 +60,7 @@ MappedFile::MappedFile(const std::filesystem::path& path, MapMode mode)
     data_ = static_cast<const char*>(map);
     return;
   }
-  // Pipes, character devices and files whose stat size is 0 (/proc): read to the end.
+  // Regular files whose stat size is 0 (/proc): read to the end.
   std::size_t used = 0;
   copy_.resize(1 << 16);
   for (;;) {

@@ -1,10 +1,10 @@
 // Read-only view of a whole input file for the readers: mmap for regular files (no copy, the
-// page cache does the work), a read() loop for pipes and /proc-like files, or a copy of bytes
+// page cache does the work), a read() loop for /proc-like files (size 0), or a copy of bytes
 // already in memory (the fuzz targets: an exactly sized heap buffer, so a read past the end is
 // caught by AddressSanitizer, which an mmap's page padding would hide). Opening problems
-// (missing, directory, permission) throw Error(bad_input) naming the file. A streaming reader
-// maps lazily and releases the pages it has consumed, so resident memory stays at a window
-// however large the file.
+// (missing, directory, device, FIFO, socket, permission) throw Error(bad_input) naming the file. A
+// streaming reader maps lazily and releases the pages it has consumed, so resident memory stays at
+// a window however large the file.
 #pragma once
 
 #include <cstddef>

@@ -136,6 +136,12 @@ PlyHeader parse_ply_header(const MappedFile& file) {
       if (tokens.size() != 3 || !parse_number(tokens[2], count)) {
         fail_input(name, "line {}: expected 'element NAME COUNT' with a non-negative COUNT", n);
       }
+      for (const PlyElement& before : header.elements) {
+        if (before.name == tokens[1]) {
+          fail_input(name, "line {}: a second element '{}' (the first is on line {})", n,
+                     before.name, before.line);
+        }
+      }
       PlyElement element;
       element.name = std::string(tokens[1]);
       element.count = count;

@@ -473,7 +473,7 @@ class BodyReader {
         if (!parse_number(tok, o[a])) {
           fail_input(name_, "line {}: {} {} of {}: expected a number for property '{}', found {}",
                      lines.line(), e.name, r + 1, e.count, e.properties[vertex_.xyz[a]].name,
-                     quote_token(tok));
+                     quote_bad_number(tok));
         }
       }
       if (drop && !all_finite(o)) {

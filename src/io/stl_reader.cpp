@@ -97,6 +97,16 @@ bool starts_with_solid(std::string_view v) {
   return v.substr(i, 5) == "solid";
 }
 
+// Bytes no ASCII STL holds: a binary STL whose 80-byte header starts with "solid" (many
+// exporters write one) shows them in its triangle count and data.
+bool holds_binary_bytes(std::string_view v) {
+  for (const char c : v) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x20 && c != '\t' && c != '\n' && c != '\r' && c != '\f' && c != '\v') return true;
+  }
+  return false;
+}
+
 IndexedMesh read_binary_stl(const MappedFile& file, std::uint32_t count) {
   Welder welder(count / 2 + 16);
   IndexedMesh mesh;
@@ -171,7 +181,7 @@ IndexedMesh read_ascii_stl(const MappedFile& file) {
     }
     if (!parse_number(tok, value)) {
       fail_input(name, "line {}: facet {}: expected a number for the {}, found {}", tokens.line(),
-                 facets + 1, what, quote_token(tok));
+                 facets + 1, what, quote_bad_number(tok));
     }
   };
 
@@ -237,7 +247,9 @@ IndexedMesh read_ascii_stl(const MappedFile& file) {
 IndexedMesh read_stl(const MappedFile& file) {
   std::uint32_t count = 0;
   if (binary_size_matches(file, count)) return read_binary_stl(file, count);
-  if (starts_with_solid(file.view())) return read_ascii_stl(file);
+  if (starts_with_solid(file.view()) && !holds_binary_bytes(file.view().substr(0, 1024))) {
+    return read_ascii_stl(file);
+  }
   if (file.size() < 84) {
     fail_input(file.name(),
                "not a mesh file: {} bytes, too short for a binary STL (84-byte header), and no "
@@ -247,7 +259,7 @@ IndexedMesh read_stl(const MappedFile& file) {
   fail_input(file.name(),
              "not a mesh file: as a binary STL its triangle count {} (at byte 80) needs 84 + 50 * "
              "{} = {} bytes but the file has {}{}; no 'solid' (ASCII STL) or 'ply' (PLY) at the "
-             "start either",
+             "start either (a 'solid' followed by binary bytes is a binary STL's header)",
              count, count, 84 + 50 * static_cast<std::uint64_t>(count), file.size(),
              file.size() < 84 + 50 * static_cast<std::uint64_t>(count) ? " (truncated?)" : "");
 }

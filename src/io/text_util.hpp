@@ -56,6 +56,20 @@ inline std::string quote_token(std::string_view token) {
   return out;
 }
 
+// A token that is not a number, as shown in a message: quoted, and said to be out of double's
+// range when it is a number too large or too small for one ("1e400").
+inline std::string quote_bad_number(std::string_view token) {
+  const char* first = token.data();
+  const char* last = first + token.size();
+  if (first != last && *first == '+') ++first;
+  double value = 0;
+  const auto result = std::from_chars(first, last, value);
+  if (result.ec == std::errc::result_out_of_range && result.ptr == last) {
+    return quote_token(token) + " (a number beyond the range of double, about 1e-308 to 1e308)";
+  }
+  return quote_token(token);
+}
+
 // Splits a line into whitespace-separated tokens (appends to `tokens`, which is cleared first).
 template <typename Vec>
 inline void split_blanks(std::string_view line, Vec& tokens) {

@@ -1,12 +1,14 @@
 // Text point reader (XYZ, PTS, TXT, CSV): one point per line, space/tab/comma separated, extra
 // columns ignored, '#' and '//' comments and blank lines skipped, a leading PTS count line or a
-// CSV column-name line skipped. Large files are cut at line ends and parsed in parallel (TBB):
-// all at once when collecting, a batch of chunks at a time when streaming to a sink (so memory
-// holds one batch whatever the file size).
+// CSV column-name line skipped (a PTS count must match the points that follow). Decimal commas
+// ("1,5 2,5 3,5") are refused: read as separators they would give other numbers. Large files are
+// cut at line ends and parsed in parallel (TBB): all at once when collecting, a batch of chunks at
+// a time when streaming to a sink (so memory holds one batch whatever the file size).
 #include <tbb/parallel_for.h>
 
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -59,7 +61,7 @@ inline bool parse_line(const char* p, const char* end, double out[3], std::strin
     if (!parse_number(field, out[k])) {
       error = field.empty() ? fmt::format("column {} is empty (expected a number)", k + 1)
                             : fmt::format("column {}: expected a number, found {}", k + 1,
-                                          quote_token(field));
+                                          quote_bad_number(field));
       return false;
     }
   }
@@ -90,6 +92,22 @@ void parse_chunk(Chunk& chunk) {
   }
 }
 
+// "100,468 198,797 349,983": fields separated by blanks, with a comma between two digits
+// inside a field. Read as CSV that would be six numbers, the first three taken as x, y, z.
+bool has_decimal_commas(std::string_view line) {
+  bool blank_between = false;
+  bool tight_comma = false;
+  const auto digit = [](char c) { return c >= '0' && c <= '9'; };
+  for (std::size_t i = 1; i + 1 < line.size(); ++i) {
+    if (is_blank(line[i]) && !is_separator(line[i - 1]) && !is_blank(line[i + 1]) &&
+        line[i + 1] != ',') {
+      blank_between = true;
+    }
+    if (line[i] == ',' && digit(line[i - 1]) && digit(line[i + 1])) tight_comma = true;
+  }
+  return blank_between && tight_comma;
+}
+
 }  // namespace
 
 PointCloud read_xyz_points(const MappedFile& file, ReadReport& report, const PointSink* sink) {
@@ -100,6 +118,7 @@ PointCloud read_xyz_points(const MappedFile& file, ReadReport& report, const Poi
 
   // The first data line may be a PTS point count or a CSV line of column names.
   std::uint64_t line_before = 0;
+  std::optional<std::uint64_t> declared_count;
   {
     LineCursor lines(text, 0, 0);
     std::string_view line;
@@ -120,6 +139,13 @@ PointCloud read_xyz_points(const MappedFile& file, ReadReport& report, const Poi
       if (count_line || names_line) {
         text.remove_prefix(lines.position());
         line_before = lines.line();
+        if (count_line) declared_count = count;
+      } else if (has_decimal_commas(line)) {
+        fail_input(file.name(),
+                   "line {}: {} has a comma between digits in fields separated by blanks: "
+                   "decimal commas? g2s reads '.' as the decimal point and ',' as a separator "
+                   "(convert the commas to points)",
+                   lines.line(), quote_token(line));
       }
       break;
     }
@@ -162,6 +188,14 @@ PointCloud read_xyz_points(const MappedFile& file, ReadReport& report, const Poi
     }
     file.release_before(text_start + pos);
   }
+
+  if (declared_count && *declared_count != report.points + report.non_finite) {
+    fail_input(file.name(),
+               "the count line (line {}) says {} points, the file holds {} (truncated, or not "
+               "a PTS count?)",
+               line_before, *declared_count, report.points + report.non_finite);
+  }
+  report.declared = declared_count.value_or(0);
 
   PointCloud cloud;
   if (sink != nullptr) return cloud;
