@@ -88,7 +88,7 @@ void print_input_notes(const std::string& input, const ReadReport& report) {
 
 void run_mesh(MeshArgs& args) {
   Progress progress(!args.out.quiet && !args.out.json);
-  RunFacts run{args.input, 0, 0, std::chrono::steady_clock::now(), {}};
+  RunFacts run{args.input, 0, 0, std::chrono::steady_clock::now(), {}, {}};
   refuse_same_file({args.input}, args.out.output, "-o");
   checked_mesh_format(args.out.output, args.out.ascii);
   check_radius_steps(args.options.mesh.radius_steps);
@@ -105,6 +105,7 @@ void run_mesh(MeshArgs& args) {
         fmt::format(".{}.store-{}", output.filename().string(), static_cast<long>(getpid())));
     store_path = temporary->path();
     run.output_written = [&temporary] { temporary.reset(); };
+    run.temporary_store = store_path.string();
   }
   const std::uint64_t budget = args.memory > 0 ? args.memory : default_memory_budget();
   const MemoryPlan plan = plan_memory(budget, args.threads);

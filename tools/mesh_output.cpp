@@ -5,6 +5,7 @@
 
 #include <fmt/core.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -96,28 +97,57 @@ std::string why_no_surface(const TileSource& source) {
   throw_no_surface(why, facts);
 }
 
-// After the mesh is complete at its target, an interrupt must not claim that nothing was
-// written: from then on SIGINT and SIGTERM say that the file is complete and only its defect
-// summary is missing (exit 130 still: the run did not finish). Async-signal-safe: the message
-// is composed before the handler is installed.
-char g_written_message[4608];
-std::size_t g_written_length = 0;
+// Once the mesh is complete at its target (renamed into place inside the library), an interrupt
+// must not claim that nothing was written. This handler replaces the library's for the run:
+// while the target is not the new file (absent, or still the old file's inode) it hands over to
+// the library's handler (temporaries removed, "no output written"); once it is, it removes the
+// temporary store and says the file is complete but its defects were not measured (exit 130
+// still: the run did not finish). Async-signal-safe: stat, unlink, write, _exit; the strings
+// are composed before it is installed.
+struct SignalState {
+  struct sigaction library {};
+  char target[4096] = {};
+  char store[4096] = {};
+  char message[4608] = {};
+  std::size_t message_length = 0;
+  bool had_old = false;
+  dev_t old_dev = 0;
+  ino_t old_ino = 0;
+};
+SignalState g_signal;
 
-void on_signal_after_output(int) {
-  [[maybe_unused]] const ssize_t n = ::write(STDERR_FILENO, g_written_message, g_written_length);
+void on_signal_during_output(int signal) {
+  struct stat st {};
+  const bool written =
+      ::stat(g_signal.target, &st) == 0 &&
+      (!g_signal.had_old || st.st_dev != g_signal.old_dev || st.st_ino != g_signal.old_ino);
+  if (!written) {
+    g_signal.library.sa_handler(signal);
+    return;
+  }
+  if (g_signal.store[0] != '\0') ::unlink(g_signal.store);
+  [[maybe_unused]] const ssize_t n =
+      ::write(STDERR_FILENO, g_signal.message, g_signal.message_length);
   ::_exit(static_cast<int>(Exit::interrupted));
 }
 
-void interrupt_keeps_output(const std::string& output) {
+void install_output_signal_handler(const std::string& output, const std::string& store) {
+  if (output.size() >= sizeof g_signal.target || store.size() >= sizeof g_signal.store) return;
+  output.copy(g_signal.target, output.size());
+  store.copy(g_signal.store, store.size());
   const std::string message = fmt::format(
       "g2s: interrupted while measuring the mesh; {} is complete, its defects were not "
       "measured\n",
-      output.substr(0, 4096));
-  g_written_length = message.copy(g_written_message, sizeof g_written_message);
+      output);
+  g_signal.message_length = message.copy(g_signal.message, sizeof g_signal.message);
+  struct stat st {};
+  g_signal.had_old = ::stat(output.c_str(), &st) == 0;
+  g_signal.old_dev = st.st_dev;
+  g_signal.old_ino = st.st_ino;
   struct sigaction action {};
-  action.sa_handler = on_signal_after_output;
+  action.sa_handler = on_signal_during_output;
   sigemptyset(&action.sa_mask);
-  ::sigaction(SIGINT, &action, nullptr);
+  ::sigaction(SIGINT, &action, &g_signal.library);
   ::sigaction(SIGTERM, &action, nullptr);
 }
 
@@ -129,11 +159,11 @@ void write_and_report(const TileSource& source,
   const MeshFormat format = checked_mesh_format(args.output, args.ascii);
   // A degenerate cloud is refused before meshing: the mesher would make slivers of it.
   if (const std::string why = why_no_surface(source); !why.empty()) throw_no_surface(why, facts);
+  install_output_signal_handler(args.output, facts.temporary_store);
   MeshStreamWriter writer(args.output, format);
   const PipelineSummary summary = run(writer);
   if (summary.triangles == 0) throw_no_triangle(source, summary, facts);
   if (facts.output_written) facts.output_written();
-  interrupt_keeps_output(args.output);
   if (!args.quiet && format != MeshFormat::ply_binary) {
     warn_if_stl_rounds(args.output, writer, summary.report.spacing);
   }

@@ -30,6 +30,8 @@ struct RunFacts {
   // Called once the mesh is complete at its target, before it is measured (the temporary tile
   // store can go then); may be empty.
   std::function<void()> output_written;
+  // The temporary tile store, removed by an interrupt after the mesh is complete; may be empty.
+  std::string temporary_store;
 };
 
 // Runs the pipeline (`run` feeds the sink it is given) into args.output, written atomically,

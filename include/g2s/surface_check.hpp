@@ -14,10 +14,9 @@ namespace g2s {
 // distinct points that are not on one straight line; the answer names the case: no points, all
 // points the same, only two distinct points, all points on one line, or (as the mesher works in
 // float) a cloud wider than 1e38 along an axis. "On one line" allows for float rounding (the
-// mesher works in float): every point within max(1e-6 of the cloud's length, 4 float steps of
-// its largest coordinate) of the line through two points about a diameter apart (found by two
-// farthest-point sweeps), all but one stray point allowed. Linear time; only the collinear
-// case allocates (to count distinct points).
+// mesher works in float): every point within 1e-6 of the cloud's length of the line through two
+// points about a diameter apart (found by two farthest-point sweeps), all but one stray point
+// allowed. Linear time; only the collinear case allocates (to count distinct points).
 std::string why_no_surface(const PointCloud& cloud);
 
 // The same for `n` points visited by `each` (which calls its argument with every point's x, y,

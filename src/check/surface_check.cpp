@@ -120,15 +120,9 @@ std::string why_no_surface(std::uint64_t n, const PointVisitor& each) {
     return n == 1 ? "the cloud has a single point"
                   : fmt::format("all {} points are the same point", n);
   }
-  // Float keeps about 7 digits, of the extent (the mesher works in float around a tile's
-  // centre) and of the coordinates (the input may have been float): points closer to the line
-  // than that are on it for the mesher.
-  double largest = 0.0;
-  for (int axis = 0; axis < 3; ++axis) {
-    largest = std::max({largest, std::abs(lo[axis]), std::abs(hi[axis])});
-  }
-  const double float_step = 4.0 * static_cast<double>(std::numeric_limits<float>::epsilon());
-  const double tolerance = std::max(1e-6 * std::sqrt(length2), float_step * largest);
+  // Float keeps about 7 digits: points closer to the line than a millionth of the extent are on
+  // it for the mesher (which works in float around each tile's centre).
+  const double tolerance = 1e-6 * std::sqrt(length2);
   std::string stray;
   Point off{};
   const std::size_t off_line = count_off_line(each, a, b, tolerance, off);
@@ -140,8 +134,7 @@ std::string why_no_surface(std::uint64_t n, const PointVisitor& each) {
     if (on_one_line) break;
     const Point other = farthest_from(each, end, &out);
     if (other == end) continue;
-    const double tolerance_without =
-        std::max(1e-6 * std::sqrt(distance2(end, other)), float_step * largest);
+    const double tolerance_without = 1e-6 * std::sqrt(distance2(end, other));
     if (count_off_line(each, end, other, tolerance_without, off, &out) == 0) {
       on_one_line = true;
       stray = fmt::format(" but the one at ({}, {}, {})", out[0], out[1], out[2]);
@@ -153,8 +146,8 @@ std::string why_no_surface(std::uint64_t n, const PointVisitor& each) {
     return fmt::format("the cloud has only 2 distinct points ({} in all)", n);
   }
   return fmt::format(
-      "all {} points ({} distinct){} lie on one straight line (to within {:.3g}, float "
-      "precision)",
+      "all {} points ({} distinct){} lie on one straight line (to within {:.3g}, a "
+      "millionth of their extent)",
       n, distinct, stray, tolerance);
 }
 

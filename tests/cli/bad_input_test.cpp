@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "g2s/io.hpp"
+#include "support/cli_runner.hpp"
 #include "support/temp_folder.hpp"
 
 namespace {
@@ -38,12 +39,7 @@ constexpr int kBadInput = 3;
 constexpr int kWriteFailed = 4;
 constexpr int kNoSurface = 5;
 
-struct CliRun {
-  int exit_code = -1;  // -1: killed by a signal or by the deadline
-  std::string out;     // stdout
-  std::string err;     // stderr, or why the run failed
-};
-
+using g2s::test_support::CliRun;
 using g2s::test_support::file_bytes;
 
 // A 30 x 30 grid of points 0.125 apart, exact in binary, on the surface z = height(x, y).
@@ -111,37 +107,7 @@ class BadInput : public ::testing::Test {
 
   // Runs the g2s CLI with `args`; a run past `seconds` is killed and fails the test as a hang.
   CliRun run(const std::vector<std::string>& args, double seconds = 60.0) {
-    const fs::path out_path = dir_ / "cli.stdout";
-    const fs::path err_path = dir_ / "cli.stderr";
-    const pid_t pid = fork();
-    if (pid < 0) return {-1, "", "fork() failed"};
-    if (pid == 0) {
-      const int out = ::open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      const int err = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      if (out < 0 || err < 0 || dup2(out, STDOUT_FILENO) < 0 || dup2(err, STDERR_FILENO) < 0) {
-        _exit(127);
-      }
-      std::vector<char*> argv{const_cast<char*>("g2s")};
-      for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-      argv.push_back(nullptr);
-      execv(G2S_CLI_PATH, argv.data());
-      _exit(127);
-    }
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    int status = 0;
-    while (waitpid(pid, &status, WNOHANG) != pid) {
-      if (std::chrono::steady_clock::now() > deadline) {
-        kill(pid, SIGKILL);
-        waitpid(pid, &status, 0);
-        ADD_FAILURE() << "g2s did not finish within " << seconds << " s (hang?)";
-        return {-1, file_bytes(out_path), "timed out"};
-      }
-      usleep(2000);
-    }
-    CliRun result{WIFEXITED(status) ? WEXITSTATUS(status) : -1, file_bytes(out_path),
-                  file_bytes(err_path)};
-    if (WIFSIGNALED(status)) result.err += fmt::format("\n[killed by signal {}]", WTERMSIG(status));
-    return result;
+    return g2s::test_support::run_cli(dir_, args, seconds);
   }
 
   // `g2s mesh input -o output` plus extra arguments.

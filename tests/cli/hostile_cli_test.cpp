@@ -1,0 +1,331 @@
+// Hostile use of the g2s command line (issue 19): an output that is an input, a device or a
+// link; a kept store or growth files made for something else; degenerate clouds; options that
+// cannot work; paths that break JSON; a signal after the output is complete. Each runs the real
+// CLI and checks the exit code, the message and what is left on disk.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "g2s/io.hpp"
+#include "support/cli_runner.hpp"
+#include "support/temp_folder.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using g2s::test_support::CliRun;
+using g2s::test_support::file_bytes;
+
+constexpr int kOk = 0;
+constexpr int kUsage = 2;
+constexpr int kBadInput = 3;
+constexpr int kWriteFailed = 4;
+constexpr int kNoSurface = 5;
+
+class HostileCli : public ::testing::Test {
+ protected:
+  CliRun run(const std::vector<std::string>& args) {
+    return g2s::test_support::run_cli(dir_, args);
+  }
+  fs::path path(const std::string& name) const { return dir_ / name; }
+  // A synthetic cloud of `points` points of `shape`, written once per test.
+  fs::path cloud(const std::string& name, const std::string& shape, const std::string& points) {
+    const CliRun r = run({"synth", shape, "--points", points, "-o", path(name).string()});
+    EXPECT_EQ(r.exit_code, kOk) << r.err;
+    return path(name);
+  }
+  fs::path write(const std::string& name, const std::string& text) {
+    std::ofstream(path(name), std::ios::binary) << text;
+    return path(name);
+  }
+  static void expect_says(const CliRun& r, int code, const std::vector<std::string>& parts) {
+    EXPECT_EQ(r.exit_code, code) << r.err;
+    for (const std::string& part : parts) {
+      EXPECT_NE(r.err.find(part), std::string::npos) << "stderr: " << r.err << "\nwants: " << part;
+    }
+  }
+
+  g2s::test_support::TempFolder folder_{"g2s-hostile-cli"};
+  const fs::path dir_ = folder_.path();
+};
+
+// Item 1: however the output is spelled, it is refused when it is the input, which stays.
+TEST_F(HostileCli, OutputThatIsTheInputIsRefused) {
+  const fs::path in = cloud("in.ply", "sphere", "2000");
+  const std::string before = file_bytes(in);
+  fs::create_symlink(in, path("link.ply"));
+  fs::create_hard_link(in, path("hard.ply"));
+  fs::create_directories(path("sub"));
+  const std::string dotted = (dir_ / "sub" / ".." / "in.ply").string();
+  for (const std::string& output :
+       {in.string(), path("link.ply").string(), path("hard.ply").string(), dotted}) {
+    expect_says(run({"mesh", in.string(), "-o", output}), kUsage, {"same file as the input"});
+    expect_says(run({"tile", in.string(), output}), kUsage, {"same file as the input"});
+    expect_says(run({"synth", "--from", in.string(), "-o", output}), kUsage,
+                {"same file as the input"});
+  }
+  expect_says(run({"mesh", in.string(), "-o", path("m.ply").string(), "--keep-store", dotted}),
+              kUsage, {"same file as the input"});
+  EXPECT_EQ(file_bytes(in), before);
+}
+
+// Item 2: a device or FIFO at the output is left alone; a symbolic link is written through.
+TEST_F(HostileCli, SpecialFilesAsOutput) {
+  const fs::path in = cloud("in.ply", "sphere", "2000");
+  fs::create_symlink("/dev/null", path("null.stl"));
+  expect_says(run({"mesh", in.string(), "-o", path("null.stl").string()}), kWriteFailed,
+              {"null.stl", "not a regular file"});
+  EXPECT_TRUE(fs::is_character_file("/dev/null"));
+  EXPECT_TRUE(fs::is_symlink(path("null.stl")));
+  ASSERT_EQ(mkfifo(path("fifo.ply").c_str(), 0644), 0);
+  expect_says(run({"mesh", in.string(), "-o", path("fifo.ply").string()}), kWriteFailed,
+              {"fifo.ply", "not a regular file"});
+  EXPECT_TRUE(fs::is_fifo(path("fifo.ply")));
+  write("target.ply", "old");
+  fs::create_symlink("target.ply", path("link.ply"));
+  expect_says(run({"mesh", in.string(), "-o", path("link.ply").string(), "-q"}), kOk, {});
+  EXPECT_TRUE(fs::is_symlink(path("link.ply")));
+  EXPECT_GT(g2s::read_mesh(path("target.ply")).triangles.size(), 3000u);
+}
+
+// Item 3: a kept store is reused only for the cloud and tiling it was made from.
+TEST_F(HostileCli, KeptStoreOfAnotherCloudIsNotReused) {
+  const fs::path a = cloud("a.ply", "sphere", "3000");
+  const fs::path b = cloud("b.ply", "torus", "3000");
+  const std::string store = path("k.store").string();
+  ASSERT_EQ(run({"mesh", b.string(), "-o", path("b-alone.ply").string(), "-q"}).exit_code, kOk);
+  ASSERT_EQ(
+      run({"mesh", a.string(), "-o", path("a.ply.out.ply").string(), "-q", "--keep-store", store})
+          .exit_code,
+      kOk);
+  // A's store is newer than B: it must not be taken for B's.
+  const CliRun r =
+      run({"mesh", b.string(), "-o", path("b.out.ply").string(), "--keep-store", store});
+  expect_says(r, kOk, {"tiling again"});
+  EXPECT_EQ(file_bytes(path("b.out.ply")), file_bytes(path("b-alone.ply")));
+  // Another --tile-points re-tiles too.
+  expect_says(run({"mesh", b.string(), "-o", path("b2.ply").string(), "--keep-store", store,
+                   "--tile-points", "1000"}),
+              kOk, {"--tile-points", "tiling again"});
+  // The same input and options reuse it silently.
+  const CliRun again = run({"mesh", b.string(), "-o", path("b3.ply").string(), "--keep-store",
+                            store, "--tile-points", "1000"});
+  EXPECT_EQ(again.exit_code, kOk);
+  EXPECT_EQ(again.err.find("tiling again"), std::string::npos) << again.err;
+  // A file that is no store is never overwritten.
+  const std::string before = file_bytes(a);
+  expect_says(run({"mesh", b.string(), "-o", path("b4.ply").string(), "--keep-store", a.string()}),
+              kUsage, {"not a g2s tile store"});
+  EXPECT_EQ(file_bytes(a), before);
+}
+
+// Item 4: growth files remember their options; grow redoes others, stitch refuses them.
+TEST_F(HostileCli, GrowthsMadeWithOtherOptions) {
+  const fs::path in = cloud("in.ply", "torus", "4000");
+  const std::string store = path("s.store").string();
+  ASSERT_EQ(run({"tile", in.string(), store, "-q", "--tile-points", "1500"}).exit_code, kOk);
+  ASSERT_EQ(run({"grow", store, "-q"}).exit_code, kOk);
+  const CliRun regrow = run({"grow", store, "--max-radius", "2"});
+  expect_says(regrow, kOk, {"(0 already there)"});
+  expect_says(run({"stitch", store, "-o", path("m.ply").string()}), kUsage,
+              {"tile-000000.g2sgrow", "other mesh options"});
+  EXPECT_FALSE(fs::exists(path("m.ply")));
+  expect_says(run({"stitch", store, "-o", path("m.ply").string(), "--max-radius", "2", "-q"}), kOk,
+              {});
+}
+
+// Item 5: points on one line within float precision, also with one stray point, are no
+// surface; a cloud with two points off the line is meshed.
+TEST_F(HostileCli, CollinearWithinFloatIsNoSurface) {
+  std::string line, stray, plane;
+  for (int i = 0; i < 2000; ++i)
+    line += fmt::format("{} {} {}\n", i * 0.1, 2 * i * 0.1, 3 * i * 0.1);
+  stray = line + "5 0 0\n";
+  for (const auto& [name, text] : {std::pair{"line.xyz", line}, std::pair{"stray.xyz", stray}}) {
+    const CliRun r = run({"mesh", write(name, text).string(), "-o", path("m.ply").string()});
+    expect_says(r, kNoSurface, {name, "lie on one straight line"});
+    EXPECT_FALSE(fs::exists(path("m.ply")));
+  }
+  const CliRun far =
+      run({"mesh", write("far.xyz", line + "5000 0 0\n").string(), "-o", path("m.ply").string()});
+  expect_says(far, kNoSurface, {"but the one at (5000, 0, 0)"});
+}
+
+// Item 14: a sphere and one point at 1e30 names the true reason (float precision), not a line.
+TEST_F(HostileCli, FarStrayPointNamesFloatPrecision) {
+  std::string text;
+  for (int i = 0; i < 40; ++i) {
+    for (int j = 0; j < 40; ++j)
+      text += fmt::format("{} {} {}\n", i * 0.1, j * 0.1, 0.01 * ((i * j) % 5));
+  }
+  const CliRun r =
+      run({"mesh", write("far.xyz", text + "1e30 0 0\n").string(), "-o", path("m.ply").string()});
+  EXPECT_EQ(r.err.find("straight line"), std::string::npos) << r.err;
+  expect_says(r, kNoSurface, {"float coordinates", "stray point"});
+}
+
+// Items 7 and 9: values that cannot work are refused in one short line saying what is valid.
+TEST_F(HostileCli, OptionsThatCannotWork) {
+  const std::string in = cloud("in.ply", "sphere", "2000").string();
+  const std::string out = path("m.ply").string();
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"mesh", in, "-o", out, "--max-fold", "nan"}, "a number from 10 to 179"},
+      {{"mesh", in, "-o", out, "--max-radius", "inf"}, "a number from 1 to 1000"},
+      {{"mesh", in, "-o", out, "--radius-steps", "nan"}, "--radius-steps"},
+      {{"mesh", in, "-o", out, "--radius-steps", "2", "1"}, "increasing"},
+      {{"grow", "x.store", "--radius-steps", "1", "-1"}, "--radius-steps"},
+      {{"mesh", in, "-o", out, "--tile-points", "10"}, "from 500"},
+      {{"tile", in, path("s.store").string(), "--tile-points", "1"}, "from 500"},
+      {{"mesh", in, "-o", out, "--threads", "-1"}, "a whole number from 0 to"},
+      {{"mesh", in, "-o", out, "--memory", "-5G"}, "such as 512M or 4G"},
+      {{"frobnicate"}, "unknown command 'frobnicate'; the commands are mesh"},
+  };
+  for (const auto& [args, says] : cases) {
+    const CliRun r = run(args);
+    EXPECT_EQ(r.exit_code, kUsage) << fmt::format("{}", fmt::join(args, " ")) << "\n" << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "not one line: " << r.err;
+    EXPECT_LT(r.err.size(), 200u) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// Item 8: an output format g2s does not write is refused, not replaced by another.
+TEST_F(HostileCli, UnsupportedOutputFormats) {
+  const std::string in = cloud("in.ply", "sphere", "2000").string();
+  expect_says(run({"mesh", in, "-o", path("m.obj").string()}), kUsage, {"'.obj'", ".stl or .ply"});
+  expect_says(run({"mesh", in, "-o", path("mesh").string()}), kUsage, {"no extension"});
+  expect_says(run({"mesh", in, "-o", path("m.ply").string(), "--ascii"}), kUsage,
+              {"--ascii applies to STL only"});
+  ASSERT_EQ(run({"mesh", in, "-o", path("m.stl").string(), "-q"}).exit_code, kOk);
+  expect_says(run({"render", path("m.stl").string(), "-o", path("m.jpg").string()}), kUsage,
+              {"must end in .png"});
+  expect_says(run({"synth", "--from", in, "-o", path("c.xyz").string()}), kUsage,
+              {"must end in .ply"});
+  for (const char* name : {"m.obj", "mesh", "m.jpg", "c.xyz"}) EXPECT_FALSE(fs::exists(path(name)));
+}
+
+// Item 10: endless devices are refused by every command that reads.
+TEST_F(HostileCli, EndlessDevicesAreBadInput) {
+  const std::string mesh = path("m.stl").string();
+  ASSERT_EQ(run({"mesh", cloud("in.ply", "sphere", "2000").string(), "-o", mesh, "-q"}).exit_code,
+            kOk);
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"stats", "/dev/zero"},
+        {"stats", mesh, "--points", "/dev/zero"},
+        {"render", "/dev/zero", "-o", path("x.png").string()},
+        {"tile-info", "/dev/zero"},
+        {"grow", "/dev/zero"},
+        {"synth", "--from", "/dev/zero", "-o", path("x.ply").string()}}) {
+    expect_says(run(args), kBadInput, {"/dev/zero", "not a regular file"});
+  }
+}
+
+// Item 13: a mesh with a vertex at NaN draws its finite triangles, with a warning.
+TEST_F(HostileCli, RenderLeavesOutNonFiniteTriangles) {
+  const fs::path mesh = write("nan.ply",
+                              "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\n"
+                              "property float y\nproperty float z\nelement face 2\n"
+                              "property list uchar int vertex_indices\nend_header\n"
+                              "0 0 0\n1 0 0\n0 1 0\nnan 0 0\n3 0 1 2\n3 1 3 2\n");
+  const CliRun r = run({"render", mesh.string(), "-o", path("p.png").string(), "--size", "64x64"});
+  expect_says(r, kOk, {"1 of 2 triangles have a vertex at NaN"});
+  const std::string png = file_bytes(path("p.png"));
+  ASSERT_FALSE(png.empty());
+  // The blank picture (no triangle drawn) of the same size compresses to fewer bytes.
+  const fs::path none = write("none.ply",
+                              "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
+                              "property float y\nproperty float z\nelement face 0\n"
+                              "property list uchar int vertex_indices\nend_header\n0 0 0\n");
+  ASSERT_EQ(
+      run({"render", none.string(), "-o", path("blank.png").string(), "--size", "64x64"}).exit_code,
+      kOk);
+  EXPECT_GT(png.size(), file_bytes(path("blank.png")).size());
+}
+
+// Item 15: paths with quotes and backslashes give valid JSON strings in every command.
+TEST_F(HostileCli, JsonEscapesPaths) {
+  fs::create_directories(path("q\"uote\\d"));
+  const fs::path in = cloud("q\"uote\\d/in.ply", "sphere", "2000");
+  const std::string out = (dir_ / "q\"uote\\d" / "m.ply").string();
+  const CliRun mesh = run({"mesh", in.string(), "-o", out, "--json"});
+  ASSERT_EQ(mesh.exit_code, kOk) << mesh.err;
+  EXPECT_NE(mesh.out.find("q\\\"uote\\\\d/in.ply"), std::string::npos) << mesh.out;
+  const std::string store = (dir_ / "q\"uote\\d" / "s.store").string();
+  ASSERT_EQ(run({"tile", in.string(), store, "-q"}).exit_code, kOk);
+  ASSERT_EQ(run({"grow", store, "-q"}).exit_code, kOk);
+  const CliRun stitch = run({"stitch", store, "-o", out, "--json"});
+  ASSERT_EQ(stitch.exit_code, kOk) << stitch.err;
+  EXPECT_NE(stitch.out.find("q\\\"uote\\\\d/s.store"), std::string::npos) << stitch.out;
+  EXPECT_EQ(stitch.out.find("q\"uote"), std::string::npos) << stitch.out;
+}
+
+// Item 16: messages name what the user typed, and duplicates alone raise no stray warning.
+TEST_F(HostileCli, MessagesNameTheUsersFiles) {
+  std::string text;
+  for (int i = 0; i < 30; ++i) {
+    for (int j = 0; j < 30; ++j) {
+      const std::string p = fmt::format("{} {} {}\n", i * 0.125, j * 0.125, 0.0);
+      text += p + p;  // every point twice
+    }
+  }
+  const CliRun dup = run({"mesh", write("dup.xyz", text).string(), "-o", path("d.ply").string()});
+  EXPECT_EQ(dup.exit_code, kOk) << dup.err;
+  EXPECT_EQ(dup.err.find("stray point"), std::string::npos) << dup.err;
+  const CliRun from =
+      run({"synth", "--from", write("bad.xyz", "1 2\n").string(), "-o", path("o.ply").string()});
+  expect_says(from, kBadInput, {"bad.xyz", "line 1"});
+}
+
+// Item 17: --grown naming a file is an output problem (exit 4), not an internal error.
+TEST_F(HostileCli, GrownFolderThatCannotBeMade) {
+  const fs::path in = cloud("in.ply", "sphere", "2000");
+  const std::string store = path("s.store").string();
+  ASSERT_EQ(run({"tile", in.string(), store, "-q"}).exit_code, kOk);
+  expect_says(run({"grow", store, "--grown", in.string()}), kWriteFailed,
+              {in.string(), "cannot make the folder"});
+}
+
+// Item 6: a signal once the mesh is complete says so, and the file stays, complete.
+TEST_F(HostileCli, SignalDuringTheSummaryKeepsTheCompleteFileAndSaysSo) {
+  const fs::path in = cloud("in.ply", "sphere", "300k");
+  const fs::path out = path("m.ply");
+  const fs::path err_path = path("signal.stderr");
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const int err = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (err < 0 || dup2(err, STDERR_FILENO) < 0) _exit(127);
+    execl(G2S_CLI_PATH, "g2s", "mesh", in.c_str(), "-o", out.c_str(), "--threads", "1",
+          static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  while (!fs::exists(out)) {
+    int status = 0;
+    if (waitpid(pid, &status, WNOHANG) == pid) FAIL() << "g2s ended before writing " << out;
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  kill(pid, SIGINT);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status));
+  const std::string err = file_bytes(err_path);
+  if (WEXITSTATUS(status) == 0) GTEST_SKIP() << "the summary ended before the signal arrived";
+  EXPECT_EQ(WEXITSTATUS(status), 130) << err;
+  EXPECT_EQ(err.find("no output written"), std::string::npos) << err;
+  EXPECT_NE(err.find("is complete"), std::string::npos) << err;
+  EXPECT_GT(g2s::read_mesh(out).triangles.size(), 500000u);
+}
+
+}  // namespace
