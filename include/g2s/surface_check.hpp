@@ -16,7 +16,8 @@ namespace g2s {
 // float) a cloud wider than 1e38 along an axis. "On one line" allows for float rounding (the
 // mesher works in float): every point within 1e-6 of the cloud's length of the line through two
 // points about a diameter apart (found by two farthest-point sweeps), all but one stray point
-// allowed. Linear time; only the collinear case allocates (to count distinct points).
+// allowed when ten or more are on the line. Linear time; only the collinear case allocates (to
+// count distinct points).
 std::string why_no_surface(const PointCloud& cloud);
 
 // The same for `n` points visited by `each` (which calls its argument with every point's x, y,

@@ -18,6 +18,9 @@ namespace {
 
 using Point = std::array<double, 3>;
 
+// Points on a line besides one stray point for the cloud to count as a line.
+constexpr std::uint64_t kFewestOnLineWithStray = 10;
+
 // Widest extent along an axis that float (up to 3.4e38) holds with room to spare.
 constexpr double kWidestSpan = 1e38;
 
@@ -126,12 +129,15 @@ std::string why_no_surface(std::uint64_t n, const PointVisitor& each) {
   std::string stray;
   Point off{};
   const std::size_t off_line = count_off_line(each, a, b, tolerance, off);
-  bool on_one_line = off_line <= 1;
+  // One point off a line of many is a stray point: a fan of slivers is no surface. A few points
+  // (a triangle, a line of three and a point) are left to the mesher.
+  const bool stray_allowed = n > kFewestOnLineWithStray;
+  bool on_one_line = off_line == 0 || (off_line == 1 && stray_allowed);
   if (off_line == 1) stray = fmt::format(" but the one at ({}, {}, {})", off[0], off[1], off[2]);
   // A stray point may also be a or b itself: the line is then the one through the other and
   // the point farthest from it, the stray point left out.
   for (const auto& [end, out] : {std::pair{a, b}, std::pair{b, a}}) {
-    if (on_one_line) break;
+    if (on_one_line || !stray_allowed) break;
     const Point other = farthest_from(each, end, &out);
     if (other == end) continue;
     const double tolerance_without = 1e-6 * std::sqrt(distance2(end, other));
