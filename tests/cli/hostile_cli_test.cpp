@@ -123,6 +123,17 @@ TEST_F(HostileCli, KeptStoreOfAnotherCloudIsNotReused) {
                             store, "--tile-points", "1000"});
   EXPECT_EQ(again.exit_code, kOk);
   EXPECT_EQ(again.err.find("tiling again"), std::string::npos) << again.err;
+  // A store of an older format version (here: its version field set to 1) is cut again by
+  // mesh, refused by grow.
+  std::string old = file_bytes(store);
+  old[8] = 1;
+  write("old.store", old);
+  expect_says(run({"grow", path("old.store").string()}), kBadInput,
+              {"store version 1, this g2s reads 2"});
+  expect_says(run({"mesh", b.string(), "-o", path("b5.ply").string(), "--keep-store",
+                   path("old.store").string()}),
+              kOk, {"store version 1", "tiling again"});
+  EXPECT_EQ(file_bytes(path("b5.ply")), file_bytes(path("b-alone.ply")));
   // A file that is no store is never overwritten.
   const std::string before = file_bytes(a);
   expect_says(run({"mesh", b.string(), "-o", path("b4.ply").string(), "--keep-store", a.string()}),

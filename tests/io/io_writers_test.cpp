@@ -25,6 +25,7 @@
 
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
+#include "support/expect_error.hpp"
 #include "support/temp_folder.hpp"
 
 namespace {
@@ -44,20 +45,7 @@ class IoWriteDir : public ::testing::Test {
   const fs::path dir_ = folder_.path();
 };
 
-template <typename F>
-void expect_error(F&& f, Exit code, std::initializer_list<std::string_view> parts) {
-  try {
-    f();
-    ADD_FAILURE() << "no exception thrown";
-  } catch (const g2s::Error& e) {
-    EXPECT_EQ(static_cast<int>(e.code()), static_cast<int>(code)) << e.what();
-    const std::string_view what = e.what();
-    for (std::string_view part : parts) {
-      EXPECT_NE(what.find(part), std::string_view::npos)
-          << "message: " << what << "\nshould contain: " << part;
-    }
-  }
-}
+using g2s::test_support::expect_error;
 
 using g2s::test_support::file_bytes;
 

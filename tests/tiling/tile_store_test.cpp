@@ -31,7 +31,9 @@
 #include "g2s/io.hpp"
 #include "g2s/synth.hpp"
 #include "io/readers.hpp"
+#include "support/expect_error.hpp"
 #include "support/temp_folder.hpp"
+#include "tiling/store_format.hpp"
 #include "tiling/xxhash64.hpp"
 
 namespace {
@@ -83,20 +85,7 @@ std::string read_bytes(const fs::path& path) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
-template <typename F>
-void expect_error(F&& f, Exit code, std::initializer_list<std::string_view> parts) {
-  try {
-    f();
-    ADD_FAILURE() << "no exception thrown";
-  } catch (const g2s::Error& e) {
-    EXPECT_EQ(static_cast<int>(e.code()), static_cast<int>(code)) << e.what();
-    const std::string_view what = e.what();
-    for (std::string_view part : parts) {
-      EXPECT_NE(what.find(part), std::string_view::npos)
-          << "message: " << what << "\nshould contain: " << part;
-    }
-  }
-}
+using g2s::test_support::expect_error;
 
 // Distance to the nearest face of the box that is not on the cloud's bounding box, written
 // out independently of the library's.
@@ -447,13 +436,15 @@ TEST_F(TileStoreDamage, FlippedHeaderByte) {
 }
 
 TEST_F(TileStoreDamage, FlippedTableByte) {
-  const fs::path path = damaged(flipped(192 + 96 + 50));  // tile 1's point count
+  const fs::path path =
+      damaged(flipped(g2s::tiling::kHeaderBytes + 96 + 50));  // tile 1's point count
   expect_error([&] { g2s::TileStore s(path); }, Exit::bad_input,
                {path.string() + ": ", "tile table checksum mismatch"});
 }
 
 TEST_F(TileStoreDamage, FlippedBlockBytes) {
-  const std::uint64_t block = u64(192 + 2 * 96 + 64);  // tile 2's block offset
+  const std::uint64_t block =
+      u64(g2s::tiling::kHeaderBytes + 2 * 96 + 64);  // tile 2's block offset
   {
     const fs::path path = damaged(flipped(block + 10));  // its frame table
     const g2s::TileStore store(path);                    // blocks are checked when loaded
@@ -498,10 +489,10 @@ TEST_F(TileStoreDamage, Truncated) {
 
 TEST_F(TileStoreDamage, VersionMagicAndEmptyFile) {
   std::string newer = bytes_;
-  newer[8] = 2;
+  newer[8] = 3;
   const fs::path path = damaged(newer);
   expect_error([&] { g2s::TileStore s(path); }, Exit::bad_input,
-               {"store version 2, this g2s reads 1"});
+               {"store version 3, this g2s reads 2"});
   const fs::path ply = dir_ / "sphere.ply";
   expect_error([&] { g2s::TileStore s(ply); }, Exit::bad_input,
                {ply.string() + ": ", "not a g2s tile store"});
