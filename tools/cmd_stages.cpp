@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <memory>
 #include <mutex>
+#include <string_view>
 
 #include "cli_checks.hpp"
 #include "commands.hpp"
@@ -143,8 +144,17 @@ void run_stitch(StitchArgs& args) {
       [&](MeshSink& sink) {
         Stitcher stitcher(store, args.options, sink);
         for (std::size_t t = 0; t < tiles; ++t) {
-          stitcher.add(t, read_tile_growth(growth_file(folder, t), static_cast<std::uint32_t>(t),
-                                           fingerprint, options));
+          const std::filesystem::path file = growth_file(folder, t);
+          try {
+            stitcher.add(
+                t, read_tile_growth(file, static_cast<std::uint32_t>(t), fingerprint, options));
+          } catch (const Error& e) {
+            // The stitcher's own checks (corners, point counts, ids) do not know the files.
+            if (e.code() != Exit::bad_input || std::string_view(e.what()).find(file.string()) == 0)
+              throw;
+            throw Error(e.code(), fmt::format("{}: tile {} of {}: {}", file.string(), t, args.store,
+                                              e.what()));
+          }
           progress.stage("stitching", static_cast<double>(t + 1) / static_cast<double>(tiles));
         }
         progress.clear();

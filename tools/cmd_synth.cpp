@@ -80,7 +80,12 @@ void run_perturb(const SynthArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   const PointCloud cloud = read_points(args.from);
   PerturbReport report;
-  const PointCloud out = perturb_cloud(cloud, options, &report);
+  PointCloud out;
+  try {
+    out = perturb_cloud(cloud, options, &report);
+  } catch (const Error& e) {
+    throw Error(e.code(), fmt::format("{}: {}", args.from, e.what()));  // name the cloud
+  }
   PlyPointWriter writer(args.output, out.size());
   for (std::size_t i = 0; i < out.size(); ++i) {
     writer.add(static_cast<float>(out.xyz[3 * i]), static_cast<float>(out.xyz[3 * i + 1]),
@@ -155,11 +160,11 @@ void add_synth_command(CLI::App& app) {
                   "Gaussian noise sigma per coordinate, as a fraction of the mean spacing "
                   "(SHAPE: sqrt(area / points); --from: mean nearest-neighbour distance)")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 100.0));
+      ->check(finite_range(0.0, 100.0));
   cmd->add_option("--outliers", args->outliers,
                   "Outliers, as a fraction of the points, uniform in the bounding box")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 100.0));
+      ->check(finite_range(0.0, 100.0));
   cmd->add_option("--seed", args->seed, "Random seed")->capture_default_str();
   cmd->callback([args] { run_synth(*args); });
 }

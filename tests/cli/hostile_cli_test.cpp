@@ -11,6 +11,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -20,6 +22,7 @@
 #include "g2s/io.hpp"
 #include "support/cli_runner.hpp"
 #include "support/temp_folder.hpp"
+#include "tiling/xxhash64.hpp"
 
 namespace {
 
@@ -197,6 +200,7 @@ TEST_F(HostileCli, OptionsThatCannotWork) {
       {{"mesh", in, "-o", out, "--radius-steps", "2", "1"}, "increasing"},
       {{"grow", "x.store", "--radius-steps", "1", "-1"}, "--radius-steps"},
       {{"mesh", in, "-o", out, "--tile-points", "10"}, "from 500"},
+      {{"synth", "sphere", "-n", "1000", "--noise", "nan", "-o", out}, "a number from 0 to 100"},
       {{"tile", in, path("s.store").string(), "--tile-points", "1"}, "from 500"},
       {{"mesh", in, "-o", out, "--threads", "-1"}, "a whole number from 0 to"},
       {{"mesh", in, "-o", out, "--memory", "-5G"}, "such as 512M or 4G"},
@@ -295,8 +299,26 @@ TEST_F(HostileCli, MessagesNameTheUsersFiles) {
   EXPECT_EQ(dup.exit_code, kOk) << dup.err;
   EXPECT_EQ(dup.err.find("stray point"), std::string::npos) << dup.err;
   const CliRun from =
-      run({"synth", "--from", write("bad.xyz", "1 2\n").string(), "-o", path("o.ply").string()});
-  expect_says(from, kBadInput, {"bad.xyz", "line 1"});
+      run({"synth", "--from", write("one.xyz", "1 2 3\n").string(), "-o", path("o.ply").string()});
+  expect_says(from, kBadInput, {"one.xyz: ", "at least two distinct points"});
+  // A growth file whose point count disagrees with its tile (header checksum made good): the
+  // stitcher's check names the file and the tile.
+  const fs::path in = cloud("in.ply", "sphere", "2000");
+  const std::string store = path("s.store").string();
+  ASSERT_EQ(run({"tile", in.string(), store, "-q"}).exit_code, kOk);
+  ASSERT_EQ(run({"grow", store, "-q"}).exit_code, kOk);
+  const fs::path growth = fs::path(store + ".grown") / "tile-000000.g2sgrow";
+  std::string bytes = file_bytes(growth);
+  ASSERT_GT(bytes.size(), 128u);
+  std::uint64_t points = 0;
+  std::memcpy(&points, bytes.data() + 48, 8);
+  points += 1;
+  std::memcpy(bytes.data() + 48, &points, 8);
+  const std::uint64_t checksum = g2s::tiling::xxhash64(bytes.data(), 120);
+  std::memcpy(bytes.data() + 120, &checksum, 8);
+  write(growth.lexically_relative(dir_).string(), bytes);
+  expect_says(run({"stitch", store, "-o", path("m.ply").string()}), kBadInput,
+              {"tile-000000.g2sgrow: tile 0 of ", "point count differs"});
 }
 
 // Item 17: --grown naming a file is an output problem (exit 4), not an internal error.
