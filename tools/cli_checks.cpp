@@ -10,6 +10,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <string_view>
 #include <system_error>
 
 #include "g2s/error.hpp"
@@ -110,6 +111,14 @@ CLI::Validator byte_size() {
             text);
         std::string number = text;
         double scale = 1.0;
+        // "4GiB", "512MB" and "512mb" read as "4G" and "512M".
+        for (const std::string_view unit : {"iB", "ib", "B", "b"}) {
+          if (number.size() > unit.size() + 1 && number.ends_with(unit) &&
+              std::isalpha(static_cast<unsigned char>(number[number.size() - unit.size() - 1]))) {
+            number.resize(number.size() - unit.size());
+            break;
+          }
+        }
         if (!number.empty()) {
           const char suffix =
               static_cast<char>(std::toupper(static_cast<unsigned char>(number.back())));

@@ -36,8 +36,8 @@ void require_extension(const std::filesystem::path& output, const std::string& e
 // Validators with one-line messages: a finite number in [lo, hi]; a whole number in [lo, hi].
 CLI::Validator finite_range(double lo, double hi);
 CLI::Validator count_range(long long lo, long long hi);
-// A byte size such as 512M or 4G (K, M, G, T, powers of 1024), at least 1 MiB; written back as
-// the number of bytes.
+// A byte size such as 512M or 4G (K, M, G, T, powers of 1024; "MB", "MiB" read as "M"), at least
+// 1 MiB; written back as the number of bytes.
 CLI::Validator byte_size();
 
 // Radius steps: each finite and positive, strictly increasing; throws Error(usage) otherwise.

@@ -66,12 +66,10 @@ namespace {
 // Why the points of `source` cannot form a surface (none, one point, two, a line), or "". A
 // tile too wide for float precision is named first: it is the true reason then.
 std::string why_no_surface(const TileSource& source) {
-  const std::string why = g2s::why_no_surface(source.point_count(), [&source](const auto& visit) {
-    for (std::size_t t = 0; t < source.tiles().size(); ++t) {
-      const TilePoints points = source.load(t);
-      for (std::size_t i = 0; i < points.size(); ++i) visit(&points.xyz[3 * i]);
-    }
-  });
+  const std::string why =
+      g2s::why_no_surface(source.point_count(), [&source](const PointRun& visit) {
+        for (std::size_t t = 0; t < source.tiles().size(); ++t) visit(source.load(t).xyz);
+      });
   if (why.empty()) return why;
   const std::string too_wide = why_tile_too_wide(source);
   return too_wide.empty() ? why : too_wide;

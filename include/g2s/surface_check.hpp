@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <span>
 #include <string>
 
 #include "g2s/types.hpp"
@@ -20,10 +21,11 @@ namespace g2s {
 // count distinct points).
 std::string why_no_surface(const PointCloud& cloud);
 
-// The same for `n` points visited by `each` (which calls its argument with every point's x, y,
-// z, in the same order each time; it is called up to seven times), e.g. a tile store's tiles
-// loaded one at a time.
-using PointVisitor = std::function<void(const std::function<void(const double*)>&)>;
+// The same for `n` points visited by `each`, which calls its argument with runs of points (x,
+// y, z each) holding every point, in the same order each time, e.g. a tile store's tiles loaded
+// one at a time. Real clouds take three passes; a line or nearly one up to seven and a copy.
+using PointRun = std::function<void(std::span<const double>)>;
+using PointVisitor = std::function<void(const PointRun&)>;
 std::string why_no_surface(std::uint64_t n, const PointVisitor& each);
 
 // The part of that check a bounding box answers (the tile store asks it before writing): why

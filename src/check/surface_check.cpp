@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -33,12 +34,19 @@ Point to_point(const double* p) {
   return {p[0], p[1], p[2]};
 }
 
+// Calls f(point) for every point `each` visits, a run at a time (f inlined in the loop).
+template <typename F>
+void for_each_point(const PointVisitor& each, F&& f) {
+  each([&f](std::span<const double> xyz) {
+    for (std::size_t i = 0; i + 2 < xyz.size(); i += 3) f(to_point(&xyz[i]));
+  });
+}
+
 // The point farthest from `from` (the first of equals), leaving out `skip` when given.
 Point farthest_from(const PointVisitor& each, const Point& from, const Point* skip = nullptr) {
   Point best = from;
   double best_d2 = -1.0;
-  each([&](const double* xyz) {
-    const Point p = to_point(xyz);
+  for_each_point(each, [&](const Point& p) {
     if (skip != nullptr && p == *skip) return;
     const double d2 = distance2(p, from);
     if (d2 > best_d2) best = p, best_d2 = d2;
@@ -46,31 +54,50 @@ Point farthest_from(const PointVisitor& each, const Point& from, const Point* sk
   return best;
 }
 
-// How many points (but those equal to `skip`) lie farther than `tolerance` from the line
-// through a and b (a != b), counted up to 2, and the first of them; stops at the second.
-std::size_t count_off_line(const PointVisitor& each, const Point& a, const Point& b,
-                           double tolerance, Point& first_off, const Point* skip = nullptr) {
+// The squared distance of p from the line through a with unit direction `axis`.
+double off_line2(const Point& p, const Point& a, const Point& axis) {
+  const Point d{p[0] - a[0], p[1] - a[1], p[2] - a[2]};
+  const Point off{d[1] * axis[2] - d[2] * axis[1], d[2] * axis[0] - d[0] * axis[2],
+                  d[0] * axis[1] - d[1] * axis[0]};
+  return off[0] * off[0] + off[1] * off[1] + off[2] * off[2];
+}
+
+Point unit(const Point& a, const Point& b) {
   const double length = std::sqrt(distance2(a, b));
-  const Point axis{(b[0] - a[0]) / length, (b[1] - a[1]) / length, (b[2] - a[2]) / length};
+  return {(b[0] - a[0]) / length, (b[1] - a[1]) / length, (b[2] - a[2]) / length};
+}
+
+// How many points (but those equal to `skip`) lie farther than `tolerance` from the line
+// through a and b (a != b), counted up to 2, and the first two of them; the rest of the pass
+// costs a comparison per point once two are found.
+std::size_t count_off_line(const PointVisitor& each, const Point& a, const Point& b,
+                           double tolerance, std::array<Point, 2>& off,
+                           const Point* skip = nullptr) {
+  const Point axis = unit(a, b);
   std::size_t off_line = 0;
-  each([&](const double* xyz) {
-    if (off_line >= 2) return;
-    const Point p = to_point(xyz);
-    if (skip != nullptr && p == *skip) return;
-    const Point d{p[0] - a[0], p[1] - a[1], p[2] - a[2]};
-    const Point off{d[1] * axis[2] - d[2] * axis[1], d[2] * axis[0] - d[0] * axis[2],
-                    d[0] * axis[1] - d[1] * axis[0]};
-    if (off[0] * off[0] + off[1] * off[1] + off[2] * off[2] > tolerance * tolerance) {
-      if (off_line++ == 0) first_off = p;
-    }
+  for_each_point(each, [&](const Point& p) {
+    if (off_line >= 2 || (skip != nullptr && p == *skip)) return;
+    if (off_line2(p, a, axis) > tolerance * tolerance) off[off_line++] = p;
   });
   return off_line;
+}
+
+// Whether the three points may lie within `tolerance` of one line: twice their triangle's area
+// is at most about tolerance times its longest side then (generously: four times).
+bool maybe_collinear(const Point& p, const Point& q, const Point& r, double tolerance) {
+  const Point u{q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+  const Point v{r[0] - p[0], r[1] - p[1], r[2] - p[2]};
+  const Point cross{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                    u[0] * v[1] - u[1] * v[0]};
+  const double longest = std::sqrt(std::max({distance2(p, q), distance2(p, r), distance2(q, r)}));
+  return std::sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]) <=
+         4.0 * tolerance * longest;
 }
 
 std::size_t count_distinct(const PointVisitor& each, std::uint64_t n) {
   std::vector<Point> points;
   points.reserve(n);
-  each([&](const double* xyz) { points.push_back(to_point(xyz)); });
+  for_each_point(each, [&](const Point& p) { points.push_back(p); });
   std::sort(points.begin(), points.end());
   return static_cast<std::size_t>(std::unique(points.begin(), points.end()) - points.begin());
 }
@@ -92,9 +119,7 @@ std::string why_beyond_float(const double lo[3], const double hi[3]) {
 }
 
 std::string why_no_surface(const PointCloud& cloud) {
-  return why_no_surface(cloud.size(), [&cloud](const std::function<void(const double*)>& visit) {
-    for (std::size_t i = 0; i < cloud.size(); ++i) visit(&cloud.xyz[3 * i]);
-  });
+  return why_no_surface(cloud.size(), [&cloud](const PointRun& visit) { visit(cloud.xyz); });
 }
 
 std::string why_no_surface(std::uint64_t n, const PointVisitor& each) {
@@ -104,19 +129,23 @@ std::string why_no_surface(std::uint64_t n, const PointVisitor& each) {
     lo[axis] = std::numeric_limits<double>::infinity();
     hi[axis] = -std::numeric_limits<double>::infinity();
   }
+  // The bounds, and the point farthest from the first one, in one pass. Two sweeps of "farthest
+  // point" give two points nearly a diameter apart: the line through them is the candidate for
+  // a line holding every point.
   Point first{};
   bool have_first = false;
-  each([&](const double* p) {
-    if (!have_first) first = to_point(p), have_first = true;
+  Point a{};
+  double a_d2 = -1.0;
+  for_each_point(each, [&](const Point& p) {
+    if (!have_first) first = p, have_first = true;
     for (int axis = 0; axis < 3; ++axis) {
       lo[axis] = std::min(lo[axis], p[axis]);
       hi[axis] = std::max(hi[axis], p[axis]);
     }
+    const double d2 = distance2(p, first);
+    if (d2 > a_d2) a = p, a_d2 = d2;
   });
   if (std::string why = why_beyond_float(lo, hi); !why.empty()) return why;
-  // Two sweeps of "farthest point" give two points nearly a diameter apart: the line through
-  // them is the candidate for a line holding every point.
-  const Point a = farthest_from(each, first);
   const Point b = farthest_from(each, a);
   const double length2 = distance2(a, b);
   if (length2 == 0.0) {
@@ -127,21 +156,27 @@ std::string why_no_surface(std::uint64_t n, const PointVisitor& each) {
   // it for the mesher (which works in float around each tile's centre).
   const double tolerance = 1e-6 * std::sqrt(length2);
   std::string stray;
-  Point off{};
+  std::array<Point, 2> off{};
   const std::size_t off_line = count_off_line(each, a, b, tolerance, off);
   // One point off a line of many is a stray point: a fan of slivers is no surface. A few points
   // (a triangle, a line of three and a point) are left to the mesher.
   const bool stray_allowed = n > kFewestOnLineWithStray;
   bool on_one_line = off_line == 0 || (off_line == 1 && stray_allowed);
-  if (off_line == 1) stray = fmt::format(" but the one at ({}, {}, {})", off[0], off[1], off[2]);
-  // A stray point may also be a or b itself: the line is then the one through the other and
-  // the point farthest from it, the stray point left out.
+  if (off_line == 1) {
+    stray = fmt::format(" but the one at ({}, {}, {})", off[0][0], off[0][1], off[0][2]);
+  }
+  // A stray point may also be a or b itself: the line then holds the other one and both points
+  // found off the line through a and b (a quick test that settles real clouds), and is the line
+  // through the other and the point farthest from it, the stray point left out.
   for (const auto& [end, out] : {std::pair{a, b}, std::pair{b, a}}) {
-    if (on_one_line || !stray_allowed) break;
+    if (on_one_line || !stray_allowed || !maybe_collinear(end, off[0], off[1], tolerance)) {
+      continue;
+    }
     const Point other = farthest_from(each, end, &out);
     if (other == end) continue;
     const double tolerance_without = 1e-6 * std::sqrt(distance2(end, other));
-    if (count_off_line(each, end, other, tolerance_without, off, &out) == 0) {
+    std::array<Point, 2> off_without{};
+    if (count_off_line(each, end, other, tolerance_without, off_without, &out) == 0) {
       on_one_line = true;
       stray = fmt::format(" but the one at ({}, {}, {})", out[0], out[1], out[2]);
     }
