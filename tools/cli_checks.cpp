@@ -35,14 +35,22 @@ std::string number_text(double value) {
 void refuse_same_file(std::initializer_list<std::filesystem::path> inputs,
                       const std::filesystem::path& output, const std::string& what) {
   struct stat out {};
-  if (::stat(output.c_str(), &out) != 0) return;  // not there yet: it cannot be an input
+  const bool output_exists = ::stat(output.c_str(), &out) == 0;
   for (const std::filesystem::path& input : inputs) {
     struct stat in {};
-    if (input.empty() || ::stat(input.c_str(), &in) != 0) continue;
-    if (in.st_dev == out.st_dev && in.st_ino == out.st_ino) {
+    if (input.empty()) continue;
+    const bool input_exists = ::stat(input.c_str(), &in) == 0;
+    // Two paths not there yet (a --keep-store and -o to be written) are the same when they
+    // name the same place.
+    std::error_code ec;
+    const bool same = output_exists
+                          ? input_exists && in.st_dev == out.st_dev && in.st_ino == out.st_ino
+                          : !input_exists && std::filesystem::weakly_canonical(input, ec) ==
+                                                 std::filesystem::weakly_canonical(output, ec);
+    if (same) {
       throw Error(Exit::usage,
-                  fmt::format("{} {} is the same file as the input {}; writing it would destroy "
-                              "the input: choose another path",
+                  fmt::format("{} {} is the same file as {}, which this run also reads or "
+                              "writes: choose another path",
                               what, output.string(), input.string()));
     }
   }

@@ -20,8 +20,9 @@ inline constexpr long long kFewestTilePoints = 500;
 inline constexpr long long kMostThreads = 4096;
 
 // Throws Error(usage) when `output` is the same file as one of `inputs`, however either is
-// spelled (another relative path, a symbolic link, a hard link). Paths that do not exist yet
-// cannot be the same file. `what` names the output in the message ("-o", "the store").
+// spelled (another relative path, a symbolic link, a hard link). Two paths that do not exist yet
+// are the same when they name the same place (a --keep-store and the -o of one run). `what` names
+// the output in the message ("-o", "the store").
 void refuse_same_file(std::initializer_list<std::filesystem::path> inputs,
                       const std::filesystem::path& output, const std::string& what);
 

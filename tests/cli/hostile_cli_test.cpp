@@ -73,14 +73,19 @@ TEST_F(HostileCli, OutputThatIsTheInputIsRefused) {
   const std::string dotted = (dir_ / "sub" / ".." / "in.ply").string();
   for (const std::string& output :
        {in.string(), path("link.ply").string(), path("hard.ply").string(), dotted}) {
-    expect_says(run({"mesh", in.string(), "-o", output}), kUsage, {"same file as the input"});
-    expect_says(run({"tile", in.string(), output}), kUsage, {"same file as the input"});
+    expect_says(run({"mesh", in.string(), "-o", output}), kUsage, {"is the same file as"});
+    expect_says(run({"tile", in.string(), output}), kUsage, {"is the same file as"});
     expect_says(run({"synth", "--from", in.string(), "-o", output}), kUsage,
-                {"same file as the input"});
+                {"is the same file as"});
   }
   expect_says(run({"mesh", in.string(), "-o", path("m.ply").string(), "--keep-store", dotted}),
-              kUsage, {"same file as the input"});
+              kUsage, {"is the same file as"});
   EXPECT_EQ(file_bytes(in), before);
+  // The store and the mesh of one run at one path, neither there yet.
+  expect_says(run({"mesh", in.string(), "-o", path("new.ply").string(), "--keep-store",
+                   (dir_ / "sub" / ".." / "new.ply").string()}),
+              kUsage, {"is the same file as"});
+  EXPECT_FALSE(fs::exists(path("new.ply")));
 }
 
 // Item 2: a device or FIFO at the output is left alone; a symbolic link is written through.
