@@ -23,4 +23,12 @@ pc_dir="$(dirname "$(find "$prefix" -name g2s.pc)")"
 c++ $(PKG_CONFIG_PATH="$pc_dir" pkg-config --cflags g2s) examples/mesh_in_memory.cpp \
   $(PKG_CONFIG_PATH="$pc_dir" pkg-config --libs g2s) -o "$work/pkg_config_example"
 "$work/pkg_config_example" "$work/torus.ply" "$work/pkg_config.ply"
+# The Python module, when the build has it (G2S_PYTHON): imported from the prefix, meshing.
+if module="$(find "$prefix" -path '*/dist-packages/g2s/__init__.py')" && [ -n "$module" ]; then
+  PYTHONPATH="$(dirname "$(dirname "$module")")" /usr/bin/python3 -c '
+import sys, g2s, numpy as np
+t, s = g2s.mesh(np.random.default_rng(1).normal(size=(2000, 3)) * [1, 1, 0.01])
+assert len(t) > 1000 and s["stats"]["non_manifold_edges"] == 0, s
+print("test-install: python module imported from", g2s.__file__)'
+fi
 echo "test-install: g2s installed, found by find_package and pkg-config, examples built and run"
