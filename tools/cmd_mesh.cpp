@@ -208,8 +208,8 @@ void add_output_options(CLI::App& cmd, OutputArgs& out) {
 void add_mesh_command(CLI::App& app) {
   auto args = std::make_shared<MeshArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "mesh", "Reconstruct a triangle mesh from a point cloud (PLY, XYZ/PTS) with G2S");
-  cmd->add_option("input", args->input, "Point cloud: PLY (ascii/binary) or text XYZ/PTS")
+      "mesh", "Reconstruct a triangle mesh from a point cloud (PLY, LAS, XYZ/PTS) with G2S");
+  cmd->add_option("input", args->input, "Point cloud: PLY (ascii/binary), LAS or text XYZ/PTS")
       ->required();
   add_output_options(*cmd, args->out);
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")

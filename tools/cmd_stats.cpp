@@ -53,7 +53,7 @@ void add_stats_command(CLI::App& app) {
       "Exit 0 whenever the mesh was measured, whatever its defects.");
   cmd->add_option("MESH", args->mesh, "Mesh to measure (.stl binary or ASCII, .ply)")->required();
   cmd->add_option("--points", args->points,
-                  "Input cloud (PLY, XYZ): adds its coverage, compared at float precision");
+                  "Input cloud (PLY, LAS, XYZ): adds its coverage, compared at float precision");
   cmd->add_flag("--json", args->json, "Print one JSON object instead of text");
   cmd->add_flag("--largest-component", args->largest,
                 "Measure only the largest connected piece (most triangles), e.g. a scan's own\n"

@@ -152,7 +152,7 @@ void add_synth_command(CLI::App& app) {
       cmd->add_option("--points,-n", args->points,
                       "Surface points, exactly (suffixes k, M, G: 500k, 2M); with SHAPE")
           ->transform(CLI::Validator(expand_count, "N[k|M|G]", "count"));
-  cmd->add_option("--from", args->from, "Perturb this cloud (PLY, XYZ) instead of a SHAPE")
+  cmd->add_option("--from", args->from, "Perturb this cloud (PLY, LAS, XYZ) instead of a SHAPE")
       ->excludes(shape)
       ->excludes(points);
   cmd->add_option("-o,--output", args->output, "Output file (binary PLY)")->required();

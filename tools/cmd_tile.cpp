@@ -124,7 +124,7 @@ void add_tile_commands(CLI::App& app) {
   auto args = std::make_shared<TileArgs>();
   CLI::App* cmd = app.add_subcommand(
       "tile", "Cut a point cloud into a tile store for the out-of-core pipeline (bounded memory)");
-  cmd->add_option("input", args->input, "Point cloud: PLY (ascii/binary) or text XYZ/PTS")
+  cmd->add_option("input", args->input, "Point cloud: PLY (ascii/binary), LAS or text XYZ/PTS")
       ->required();
   cmd->add_option("store", args->store, "Tile store to write (one file, written atomically)")
       ->required();

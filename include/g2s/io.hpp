@@ -18,7 +18,8 @@ namespace g2s {
 
 // What a point reader saw, for the CLI summary and the tests.
 struct ReadReport {
-  std::string format;            // "ply-binary-le", "ply-binary-be", "ply-ascii", "xyz"
+  std::string format;            // "ply-binary-le", "ply-binary-be", "ply-ascii", "xyz",
+                                 // "las-1.4-format6"
   std::uint64_t declared = 0;    // points the header declares (0 for XYZ)
   std::uint64_t points = 0;      // finite points returned
   std::uint64_t non_finite = 0;  // points dropped for a NaN or Inf coordinate
@@ -29,10 +30,12 @@ struct ReadReport {
 };
 
 // Reads the points of a cloud. PLY (ascii, binary little and big endian; the vertex element's
-// x, y, z as float or double at any position; other properties and elements skipped) or text
-// XYZ/PTS/TXT/CSV (space, tab or comma separated; extra columns ignored; '#' and '//' comment
-// lines; a PTS count line is skipped). The format is chosen by content (a "ply" magic line),
-// not by the file name; a non-PLY file holding binary bytes is an error. ASCII PLY rows are one
+// x, y, z as float or double at any position; other properties and elements skipped), ASPRS LAS
+// 1.0-1.4 (point formats 0-10; x, y, z with the header's scale and offset applied in double;
+// LAZ is Error(bad_input) saying how to decompress it; docs/las.md) or text XYZ/PTS/TXT/CSV
+// (space, tab or comma separated; extra columns ignored; '#' and '//' comment lines; a PTS count
+// line is skipped). The format is chosen by content (a "LASF" signature, a "ply" magic line),
+// not by the file name; another file holding binary bytes is an error. ASCII PLY rows are one
 // per line. A PLY body is read as far as its header declares: bytes after the last element are
 // ignored (counted in report->ignored_bytes when the vertex element is the last element), a body
 // shorter than declared is an error. NaN/Inf points are

@@ -1,8 +1,9 @@
-// read_points and scan_points: open the file once, sniff the content (the "ply" magic line, else
-// text; binary bytes in a non-PLY file are an error) and hand it to the PLY or the XYZ reader,
-// which either collects the points (read_points) or streams them to a sink in bounded memory
-// (scan_points, for the tile store). One path, so both number and reject points alike. The CLI
-// decides what an empty cloud means; at this layer zero points is a valid answer.
+// read_points and scan_points: open the file once, sniff the content (the "LASF" signature, the
+// "ply" magic line, else text; binary bytes in another file are an error) and hand it to the
+// LAS, PLY or XYZ reader, which either collects the points (read_points) or streams them to a
+// sink in bounded memory (scan_points, for the tile store). One path, so both number and reject
+// points alike. The CLI decides what an empty cloud means; at this layer zero points is a valid
+// answer.
 #include <algorithm>
 #include <string_view>
 
@@ -31,8 +32,9 @@ std::uint64_t bytes_holding_data(const MappedFile& file, std::size_t end, bool a
 PointCloud read_or_scan(const MappedFile& file, const PointSink* sink, ReadReport& r) {
   r = ReadReport{};
   if (file.size() == 0) {
-    fail_input(file.name(), "file is empty (expected a PLY or XYZ/PTS point cloud)");
+    fail_input(file.name(), "file is empty (expected a PLY, LAS or XYZ/PTS point cloud)");
   }
+  if (has_las_signature(file)) return read_las_points(file, r, sink);
   if (has_ply_magic(file)) {
     const PlyHeader header = parse_ply_header(file);
     const int vertex = header.find("vertex");
@@ -70,9 +72,9 @@ PointCloud read_or_scan(const MappedFile& file, const PointSink* sink, ReadRepor
     const auto c = static_cast<unsigned char>(head[i]);
     if (c < 0x20 && c != '\t' && c != '\n' && c != '\r' && c != '\f' && c != '\v') {
       fail_input(file.name(),
-                 "byte {}: binary data (byte value 0x{:02x}) in a file that is not PLY (it "
-                 "does not start with a 'ply' line); expected a PLY or an XYZ/PTS text point "
-                 "cloud",
+                 "byte {}: binary data (byte value 0x{:02x}) in a file that is not PLY or LAS "
+                 "(it starts with neither a 'ply' line nor 'LASF'); expected a PLY, a LAS or an "
+                 "XYZ/PTS text point cloud",
                  i, c);
     }
   }

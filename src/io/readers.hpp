@@ -34,6 +34,18 @@ IndexedMesh read_mesh_from(const MappedFile& file);
 // sink, the points go to it in order and the result is empty; without one, they are returned.
 PointCloud read_xyz_points(const MappedFile& file, ReadReport& report, const PointSink* sink);
 
+// ASPRS LAS 1.0-1.4 points, record formats 0-10 (las_reader.cpp): x, y, z of every record with
+// the header's scale and offset applied in double. Fills report->format/declared/points/
+// non_finite. With a sink, the points go to it in runs and consumed pages are released; without
+// one, they are returned. LAZ (compressed LAS) and headers that contradict the file are
+// Error(bad_input).
+PointCloud read_las_points(const MappedFile& file, ReadReport& report, const PointSink* sink);
+
+// True when the file starts with the LAS signature "LASF".
+inline bool has_las_signature(const MappedFile& file) {
+  return file.view().substr(0, 4) == "LASF";
+}
+
 // Binary or ASCII STL, welded (stl_reader.cpp); throws Error(bad_input) if it is neither.
 IndexedMesh read_stl(const MappedFile& file);
 
