@@ -71,7 +71,7 @@ class SeamStitcher {
       ids_.push_back(id);
       growable_.push_back(s != IdMap::kMissing);
       for (int a = 0; a < 3; ++a) {
-        local_.push_back(static_cast<float>(p[a] - 0.5 * (box.lo[a] + box.hi[a])));
+        local_.push_back(static_cast<float>(p[a] - frame_origin(box.lo[a], box.hi[a])));
       }
     };
     {

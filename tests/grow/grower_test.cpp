@@ -47,6 +47,7 @@ GapRun grow_around_gap(bool close_gaps) {
   for (Index v : {0, 1, 2}) growable[at[v]] = 1;  // the outer corners and D are context
   g2s::MeshOptions options;
   options.close_gaps = close_gaps;
+  if (!close_gaps) options.max_hole_edges = 0;  // hole filling would close the gap as well
   g2s::GrowResult r = g2s::grow_mesh(grid, options, {preload, labels, growable, {}, 0});
   GapRun run;
   for (const Triangle& t : r.triangles) {
