@@ -30,6 +30,10 @@ struct MeshOptions {
   // Map, the orientation groups and the fold limit allow it (docs/algorithm.md §3); off: the
   // paper's G2S alone.
   bool close_gaps = true;
+  // Once growth is over, close every hole whose boundary loop has at most this many edges with
+  // triangles over the loop's own points, where the result stays manifold, consistently
+  // oriented, unfolded and free of crossings (docs/algorithm.md, "Hole filling"); 0: none.
+  int max_hole_edges = 30;
   // Orient each closed component outward (open, mostly horizontal ones up; see
   // docs/algorithm.md §6).
   bool orient = true;

@@ -10,10 +10,13 @@
 #include <cmath>
 #include <numbers>
 
+#include "cleanup/cleanup.hpp"
 #include "common/edge_map.hpp"
 #include "common/union_find.hpp"
 #include "grow/bucket_queue.hpp"
+#include "grow/crossings.hpp"
 #include "grow/gabriel_walk.hpp"
+#include "grow/hole_filling.hpp"
 
 namespace g2s {
 namespace {
@@ -53,6 +56,7 @@ class Grower {
       : grid_(grid),
         options_(options),
         growable_(context.growable),
+        fillable_(context.fillable),
         retries_(context.retries),
         levels_(static_cast<int>(options.radius_steps.size())),
         flat_levels_(std::max(1, options.flatness_levels)),
@@ -89,6 +93,7 @@ class Grower {
       drain();
     }
     if (options_.close_gaps) close_three_edge_gaps();
+    finish_surface();
     result.group.resize(triangles_.size());
     result.flip.resize(triangles_.size());
     for (std::size_t t = 0; t < triangles_.size(); ++t) {
@@ -106,6 +111,7 @@ class Grower {
   bool used(Index i) const { return state_[i] & kUsed; }
   bool interior(Index i) const { return state_[i] == kUsed; }
   bool growable(Index i) const { return growable_.empty() || growable_[i]; }
+  bool fillable(Index i) const { return growable(i) && (fillable_.empty() || fillable_[i]); }
 
   // Enters the triangles kept before this run, each its own orientation group (joined where they
   // share an edge, and as `links` say); their open edges at growable points become the front.
@@ -267,6 +273,352 @@ class Grower {
       }
     }
     stalled_ = {};
+  }
+
+  // Once growth is over: no crossing triangles, small holes filled, and the points with more
+  // than one fan left to a single one, with the holes that leaves filled in turn
+  // (docs/algorithm.md, "No crossing triangles" and "Hole filling"). Filling first lets a hole
+  // between two fans of a point join them, where deleting one fan would leave a larger hole.
+  void finish_surface() {
+    compact(remove_crossings(detail::TriangleCells(grid_.points(), triangles_)));
+    if (options_.max_hole_edges < 3) return;
+    fill_small_holes();
+    // Points whose whole star is in this run: growable, and no corner of a triangle kept from
+    // before (the clean-up of the tiled pipeline judges those).
+    std::vector<std::uint8_t> judged(grid_.size(), 0);
+    for (std::uint32_t v = 0; v < grid_.size(); ++v) judged[v] = growable(v);
+    for (std::size_t t = 0; t < preloaded_; ++t) {
+      for (Index v : triangles_[t]) judged[v] = 0;
+    }
+    std::vector<std::uint8_t> dead;
+    std::vector<Index> unjudged;
+    mark_non_manifold_fans(triangles_, grid_.size(), second_fans_, judged, dead, unjudged);
+    second_fans_.insert(second_fans_.end(), unjudged.begin(), unjudged.end());
+    if (std::find(dead.begin(), dead.end(), 1) == dead.end()) return;
+    for (std::size_t t = 0; t < triangles_.size(); ++t) {
+      if (!dead[t]) continue;
+      for (Index v : triangles_[t]) second_fans_.push_back(v);
+    }
+    compact(std::move(dead));
+    fill_small_holes();
+  }
+
+  // Removes the triangles marked dead (never one loaded before the run) and rebuilds the
+  // Point-Edge Map.
+  void compact(std::vector<std::uint8_t> dead) {
+    std::size_t kept = 0;
+    for (std::size_t t = 0; t < triangles_.size(); ++t) {
+      if (dead[t] && t >= preloaded_) continue;
+      triangles_[kept] = triangles_[t];
+      group_[kept] = group_[t];
+      flip_[kept] = flip_[t];
+      ++kept;
+    }
+    if (kept == triangles_.size()) return;
+    triangles_.resize(kept);
+    group_.resize(kept);
+    flip_.resize(kept);
+    edges_.reset(grid_.size());
+    for (std::uint32_t t = 0; t < kept; ++t) {
+      for (int k = 0; k < 3; ++k) edges_.add(triangles_[t][k], triangles_[t][(k + 1) % 3], t);
+    }
+  }
+
+  // One round of hole filling (fill_holes) and the removal of fillings that cross each other.
+  void fill_small_holes() {
+    const auto grown = static_cast<std::uint32_t>(triangles_.size());
+    fill_holes(detail::TriangleCells(grid_.points(), triangles_));
+    std::vector<std::uint8_t> dead(triangles_.size(), 0);
+    remove_crossing_fills(grown, dead);
+    compact(std::move(dead));
+  }
+
+  // Of every pair of crossing triangles, the one grown later is marked dead (fronts that met
+  // between the layers of a noisy scan). Triangles loaded before the run are never removed.
+  // Corners of removed triangles become suspects of the non-manifold pass.
+  std::vector<std::uint8_t> remove_crossings(const detail::TriangleCells& cells) {
+    std::vector<std::uint8_t> dead(triangles_.size(), 0);
+    const auto pairs = cells.crossing_pairs([](std::uint32_t) { return false; },
+                                            [](std::uint32_t) { return true; });
+    if (pairs.empty()) return dead;
+    for (const auto& [first, second] : pairs) {
+      if (dead[first] || dead[second]) continue;
+      if (second >= preloaded_) {
+        dead[second] = 1;
+      } else if (first >= preloaded_) {
+        dead[first] = 1;
+      }
+    }
+    for (std::uint32_t t = 0; t < triangles_.size(); ++t) {
+      if (dead[t])
+        second_fans_.insert(second_fans_.end(), triangles_[t].begin(), triangles_[t].end());
+    }
+    return dead;
+  }
+
+  // The triangle as it will face once its group's orientation is applied.
+  Triangle facing(std::uint32_t t) {
+    Triangle tri = triangles_[t];
+    if (groups_.find(group_[t]).second ^ flip_[t]) std::swap(tri[1], tri[2]);
+    return tri;
+  }
+
+  // Closes every hole whose boundary loop has at most max_hole_edges edges with the least-area
+  // triangulation over the loop's points, where no triangle of it folds beyond the fold limit
+  // from its neighbours, no edge gets a third triangle and none crosses a live triangle. The
+  // loops follow the open edges as the triangles around face; at a point with several fans
+  // each edge in goes on by the first free edge out counter-clockwise from it (next_open_edges),
+  // so the gap between two fans is a hole of its own, and filling it makes the two fans one.
+  // Appends the filling triangles to triangles_.
+  void fill_holes(const detail::TriangleCells& cells) {
+    std::vector<OpenEdge> open;
+    const auto grown = static_cast<std::uint32_t>(triangles_.size());
+    for (std::uint32_t t = 0; t < grown; ++t) {
+      const Triangle tri = facing(t);
+      for (int k = 0; k < 3; ++k) {
+        const Index u = tri[k], v = tri[(k + 1) % 3];
+        if (!(edges_.find(u, v) & EdgeMap::kClosed)) open.push_back({u, v, t});
+      }
+    }
+    const std::vector<std::uint32_t> next = next_open_edges(open);
+    const std::size_t max_edges = static_cast<std::size_t>(options_.max_hole_edges);
+    std::vector<std::uint8_t> taken(open.size(), 0);
+    std::vector<std::uint32_t> on_loop(grid_.size(), kNoIndex);  // the loop a point is on
+    std::vector<Index> loop;
+    std::vector<Triangle> fill;
+    detail::HoleScratch scratch;
+    // The loops first: per loop its first edge, its length, whether it is simple (no point
+    // twice, every point growable), and its component (the surface piece it borders).
+    struct Loop {
+      std::uint32_t first, length;
+      bool simple;
+      std::uint32_t component;
+    };
+    std::vector<std::uint32_t> piece(grid_.size());
+    for (std::uint32_t v = 0; v < grid_.size(); ++v) piece[v] = v;
+    for (std::uint32_t t = 0; t < grown; ++t) {
+      const Triangle& tri = triangles_[t];
+      const std::uint32_t r0 = find_root(piece, tri[0]);
+      piece[find_root(piece, tri[1])] = r0;
+      piece[find_root(piece, tri[2])] = r0;
+    }
+    std::vector<Loop> loops;
+    for (std::uint32_t h0 = 0; h0 < open.size(); ++h0) {
+      if (taken[h0]) continue;
+      Loop l{h0, 0, true, find_root(piece, open[h0].from)};
+      std::uint32_t h = h0;
+      do {
+        taken[h] = 1;
+        const Index v = open[h].from;
+        l.simple = l.simple && on_loop[v] != h0 && fillable(v) && next[h] != h;
+        on_loop[v] = h0;
+        ++l.length;
+        h = next[h] == h ? h0 : next[h];  // an unpaired edge ends its loop
+      } while (h != h0);
+      loops.push_back(l);
+    }
+    // A piece's longest loop is its outer border, not a hole: filling it would close a patch
+    // into a shell.
+    std::vector<std::uint32_t> longest(grid_.size(), 0);
+    for (const Loop& l : loops) longest[l.component] = std::max(longest[l.component], l.length);
+    for (const Loop& l : loops) {
+      if (!l.simple || l.length < 3 || l.length > max_edges) continue;
+      if (l.length == longest[l.component]) continue;
+      loop.clear();
+      for (std::uint32_t h = l.first, k = 0; k < l.length; ++k, h = next[h]) {
+        loop.push_back(open[h].from);
+      }
+      const std::uint32_t h0 = l.first;
+      std::uint32_t h = h0;
+      // The filling traverses each loop edge the other way: the loop reversed.
+      std::reverse(loop.begin(), loop.end());
+      fill.clear();
+      const auto chord_ok = [&](std::size_t i, std::size_t j) {
+        return edges_.find(loop[i], loop[j]) == EdgeMap::kMissing;
+      };
+      if (!detail::triangulate_loop(grid_.points(), loop, chord_ok, scratch, fill)) continue;
+      if (!fill_fits(fill, cells)) continue;
+      // The triangles around face consistently along the loop: their groups become one, as
+      // they face now.
+      const std::uint32_t group = group_[open[h0].triangle];
+      do {
+        groups_.unite(groups_.find(group).first, groups_.find(group_[open[h].triangle]).first, 0);
+        h = next[h];
+      } while (h != h0);
+      const std::uint8_t flip = groups_.find(group).second;
+      const auto first = static_cast<std::uint32_t>(triangles_.size());
+      for (const Triangle& t : fill) {
+        const auto id = static_cast<std::uint32_t>(triangles_.size());
+        triangles_.push_back(t);
+        group_.push_back(group);
+        flip_.push_back(flip);
+        fill_loop_.push_back(first);
+        for (int k = 0; k < 3; ++k) edges_.add(t[k], t[(k + 1) % 3], id);
+      }
+    }
+  }
+
+  // An open edge u -> v as its triangle (`triangle`) faces.
+  struct OpenEdge {
+    Index from, to;
+    std::uint32_t triangle;
+  };
+
+  // Per open edge, the open edge its hole's loop goes on by: out of the point it leads to, the
+  // first edge counter-clockwise (about the fans' mean normal) from the direction back along
+  // it. Every point has as many open edges in as out (one each per open fan), so pairing them
+  // in angular order makes each edge out the successor of exactly one edge in, and the loops
+  // partition the open edges.
+  std::vector<std::uint32_t> next_open_edges(std::span<const OpenEdge> open) {
+    const std::uint32_t n = grid_.size();
+    std::vector<std::uint32_t> next(open.size(), kNoIndex);
+    // Open edges grouped by the point they leave and by the point they reach.
+    std::vector<std::uint32_t> out_begin(std::size_t{n} + 1, 0), in_begin(std::size_t{n} + 1, 0);
+    for (const OpenEdge& e : open) ++out_begin[e.from + 1], ++in_begin[e.to + 1];
+    for (std::uint32_t i = 0; i < n; ++i) {
+      out_begin[i + 1] += out_begin[i];
+      in_begin[i + 1] += in_begin[i];
+    }
+    std::vector<std::uint32_t> outs(open.size()), ins(open.size());
+    {
+      std::vector<std::uint32_t> out_at(out_begin.begin(), out_begin.end() - 1);
+      std::vector<std::uint32_t> in_at(in_begin.begin(), in_begin.end() - 1);
+      for (std::uint32_t h = 0; h < open.size(); ++h) {
+        outs[out_at[open[h].from]++] = h;
+        ins[in_at[open[h].to]++] = h;
+      }
+    }
+    std::vector<std::pair<double, std::uint32_t>> around;  // angle, edge (in: high bit set)
+    for (std::uint32_t v = 0; v < n; ++v) {
+      const std::uint32_t o0 = out_begin[v], o1 = out_begin[v + 1];
+      const std::uint32_t i0 = in_begin[v], i1 = in_begin[v + 1];
+      if (o1 - o0 != i1 - i0) continue;  // not consistently facing: the loops through v stop
+      if (o1 - o0 == 1) {
+        next[ins[i0]] = outs[o0];
+        continue;
+      }
+      // Directions away from v projected into the plane of the fans' mean normal.
+      const Vec3 p = grid_.position(v);
+      Vec3 normal{0, 0, 0};
+      for (std::uint32_t k = o0; k < o1; ++k)
+        normal = normal + facing_normal(open[outs[k]].triangle);
+      for (std::uint32_t k = i0; k < i1; ++k)
+        normal = normal + facing_normal(open[ins[k]].triangle);
+      normal = normalized(normal);
+      Vec3 x_axis{1, 0, 0};
+      if (std::abs(normal.x) > 0.9) x_axis = {0, 1, 0};
+      x_axis = normalized(cross(cross(normal, x_axis), normal));
+      const Vec3 y_axis = cross(normal, x_axis);
+      const auto angle_of = [&](Index w) {
+        const Vec3 d = grid_.position(w) - p;
+        return std::atan2(dot(d, y_axis), dot(d, x_axis));
+      };
+      around.clear();
+      for (std::uint32_t k = o0; k < o1; ++k)
+        around.push_back({angle_of(open[outs[k]].to), outs[k]});
+      for (std::uint32_t k = i0; k < i1; ++k) {
+        around.push_back({angle_of(open[ins[k]].from), ins[k] | 0x80000000u});
+      }
+      std::sort(around.begin(), around.end());
+      // Each edge in, in angular order, takes the first edge out after it counter-clockwise
+      // that no edge in has taken.
+      const std::size_t m = around.size();
+      for (std::size_t a = 0; a < m; ++a) {
+        if (!(around[a].second & 0x80000000u)) continue;
+        for (std::size_t b = 1; b < m; ++b) {
+          std::pair<double, std::uint32_t>& cand = around[(a + b) % m];
+          if (cand.second & 0xC0000000u) continue;  // an edge in, or an edge out taken
+          next[around[a].second & 0x7FFFFFFFu] = cand.second;
+          cand.second |= 0x40000000u;
+          break;
+        }
+      }
+    }
+    // A loop through a point whose edges could not be paired is not followed.
+    for (std::uint32_t h = 0; h < open.size(); ++h) {
+      if (next[h] == kNoIndex) next[h] = h;
+    }
+    return next;
+  }
+
+  Vec3 facing_normal(std::uint32_t t) {
+    const Triangle tri = facing(t);
+    const Vec3 a = grid_.position(tri[0]);
+    return normalized(cross(grid_.position(tri[1]) - a, grid_.position(tri[2]) - a));
+  }
+
+  // Whether the triangles filling one hole keep within the fold limit of each other and of the
+  // triangles around the hole (`owner`: per point, the triangle on its open edge out), and
+  // cross no live triangle of the mesh.
+  bool fill_fits(std::span<const Triangle> fill, const detail::TriangleCells& cells) {
+    const auto normal = [&](const Triangle& t) {
+      const Vec3 a = grid_.position(t[0]);
+      return normalized(cross(grid_.position(t[1]) - a, grid_.position(t[2]) - a));
+    };
+    for (std::size_t i = 0; i < fill.size(); ++i) {
+      const Triangle& t = fill[i];
+      const Vec3 n = normal(t);
+      for (int k = 0; k < 3; ++k) {
+        const Index u = t[k], v = t[(k + 1) % 3];
+        // Across a loop edge: the triangle around the hole on edge u-v.
+        const std::uint32_t around = edges_.find(u, v);
+        if (around != EdgeMap::kMissing && !(around & EdgeMap::kClosed) &&
+            dot(n, normal(facing(around))) < cos_max_fold_) {
+          return false;
+        }
+        // Across a chord: another filling triangle.
+        for (std::size_t j = i + 1; j < fill.size(); ++j) {
+          if (traverses(fill[j], v, u) && dot(n, normal(fill[j])) < cos_max_fold_) return false;
+        }
+      }
+      const Vec3f& p0 = grid_.point(t[0]);
+      const Vec3f& p1 = grid_.point(t[1]);
+      const Vec3f& p2 = grid_.point(t[2]);
+      const Vec3f lo{std::min({p0.x, p1.x, p2.x}), std::min({p0.y, p1.y, p2.y}),
+                     std::min({p0.z, p1.z, p2.z})};
+      const Vec3f hi{std::max({p0.x, p1.x, p2.x}), std::max({p0.y, p1.y, p2.y}),
+                     std::max({p0.z, p1.z, p2.z})};
+      // Points this run may not use (a seam's context: tiles still to come) must not lie in
+      // the triangle's smallest ball: the surface may yet be meshed over them.
+      Ball ball;
+      if (!circumball(grid_.position(t[0]), grid_.position(t[1]), grid_.position(t[2]), ball)) {
+        return false;
+      }
+      if (!growable_.empty()) {
+        bool covers_context = false;
+        grid_.for_each_in_ball(ball.centre, std::sqrt(ball.radius2), [&](std::uint32_t j, double) {
+          covers_context = covers_context || !growable(j);
+        });
+        if (covers_context) return false;
+      }
+      bool crosses = false;
+      cells.for_each_near(lo, hi, [&](std::uint32_t other) {
+        crosses = crosses || detail::triangles_cross(grid_.points(), t, triangles_[other]);
+      });
+      if (crosses) return false;
+    }
+    return true;
+  }
+
+  // Fillings of neighbouring holes may cross each other: the later filling of each crossing
+  // pair goes whole (its hole opens again as it was). Fillings start at triangle `first_fill`;
+  // fill_loop_ gives each the first triangle of its filling.
+  void remove_crossing_fills(std::uint32_t first_fill, std::vector<std::uint8_t>& dead) {
+    if (triangles_.size() == first_fill) return;
+    const std::span<const Triangle> fills =
+        std::span<const Triangle>(triangles_).subspan(first_fill);
+    const auto pairs = detail::TriangleCells(grid_.points(), fills)
+                           .crossing_pairs([](std::uint32_t) { return false; },
+                                           [](std::uint32_t) { return true; });
+    for (const auto& [first, second] : pairs) {
+      const std::uint32_t earlier = fill_loop_[first], later = fill_loop_[second];
+      if (dead[earlier]) continue;
+      for (std::uint32_t t = later; t < triangles_.size() && fill_loop_[t - first_fill] == later;
+           ++t) {
+        dead[t] = 1;
+      }
+    }
+    fill_loop_.clear();
   }
 
   // Processes front edges until the front is empty (ALGORITHM.md §5).
@@ -539,6 +891,7 @@ class Grower {
   const HashGrid& grid_;
   const MeshOptions& options_;
   const std::span<const std::uint8_t> growable_;
+  const std::span<const std::uint8_t> fillable_;
   const int retries_;
   const int levels_;
   const int flat_levels_;
@@ -554,7 +907,8 @@ class Grower {
   // that the interior test of every point a search ball holds is a single load.
   static constexpr std::uint32_t kUsed = 0x80000000u;
   std::vector<std::uint32_t> state_;
-  std::vector<FrontEdge> stalled_;  // edges that left the queue without a triangle (stall())
+  std::vector<FrontEdge> stalled_;        // edges that left the queue without a triangle (stall())
+  std::vector<std::uint32_t> fill_loop_;  // per filling triangle: the first of its filling
   std::uint64_t used_count_ = 0;
   BucketQueue<FrontEdge> queue_;
   const int last_priority_;

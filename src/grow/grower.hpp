@@ -28,6 +28,9 @@ struct GrowContext {
   std::span<const Link> preload_links;
   // How many more points, in Gabriel order, an edge tries when its Gabriel point cannot join.
   int retries = 0;
+  // Per grid point, non-zero: may be a corner of a triangle that fills a hole (a tile's points
+  // out of every seam's reach: holes nearer a seam are the seam's); empty: every growable one.
+  std::span<const std::uint8_t> fillable;
 };
 
 struct GrowResult {

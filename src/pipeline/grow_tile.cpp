@@ -99,12 +99,13 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
       points.xyz.insert(points.xyz.end(), &border.xyz[3 * k], &border.xyz[3 * k + 3]);
     }
   }
-  // Local float frame at the box centre (computed in double: georeferenced clouds keep their
-  // precision).
+  // Local float frame near the box (frame_origin: exact for float input; georeferenced clouds
+  // keep their precision).
+  const double origin[3] = {frame_origin(box.lo[0], box.hi[0]), frame_origin(box.lo[1], box.hi[1]),
+                            frame_origin(box.lo[2], box.hi[2])};
   std::vector<float> local(points.xyz.size());
   for (std::size_t k = 0; k < local.size(); ++k) {
-    const int a = static_cast<int>(k % 3);
-    local[k] = static_cast<float>(points.xyz[k] - 0.5 * (box.lo[a] + box.hi[a]));
+    local[k] = static_cast<float>(points.xyz[k] - origin[k % 3]);
   }
   const HashGrid grid(local, points.ids);
   out.report.points = own;
@@ -114,7 +115,17 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
   const auto grow_start = std::chrono::steady_clock::now();
   MeshOptions mesh_options = options.mesh;
   mesh_options.progress = {};  // tiles grow in parallel; the pipeline reports per tile
-  GrowResult grown = grow_mesh(grid, mesh_options);
+  // Holes are filled here only among the points no seam reaches; the seams fill the others.
+  const double fill_depth = seam_depth(tiles, tile, options);
+  std::vector<std::uint8_t> fillable(grid.size(), 0);
+  for (std::uint32_t k = 0; k < grid.size(); ++k) {
+    const std::uint32_t s = grid.source(k);
+    fillable[k] = s < own && box_depth(box, &points.xyz[3 * std::size_t{s}]) > fill_depth;
+  }
+  GrowContext context;
+  context.fillable = fillable;
+  GrowResult grown = grow_mesh(grid, mesh_options, context);
+  fillable = std::vector<std::uint8_t>();
   out.report.seeds = grown.seeds;
 
   // Per grid point: its index among the tile's points (which come first), or kNoIndex for a

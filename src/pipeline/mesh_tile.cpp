@@ -8,6 +8,7 @@
 #include "g2s/mesher.hpp"
 #include "grid/hash_grid.hpp"
 #include "grow/grower.hpp"
+#include "pipeline/tile_geometry.hpp"
 
 namespace g2s {
 namespace {
@@ -82,7 +83,7 @@ TileMesh mesh_cloud(const PointCloud& cloud, const MeshOptions& options) {
   std::vector<float> local(3 * n);
   for (std::size_t i = 0; i < n; ++i) {
     for (int a = 0; a < 3; ++a) {
-      local[3 * i + a] = static_cast<float>(cloud.xyz[3 * i + a] - 0.5 * (lo[a] + hi[a]));
+      local[3 * i + a] = static_cast<float>(cloud.xyz[3 * i + a] - frame_origin(lo[a], hi[a]));
     }
   }
   return mesh_tile(local, {}, options);

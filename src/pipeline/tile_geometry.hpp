@@ -12,6 +12,22 @@
 
 namespace g2s {
 
+// The origin, on one axis, of the local float frame for points in [lo, hi] (and a margin as wide
+// again on each side, for halos): 0 when that range reaches the origin or lies near it for its
+// width, else the range's centre rounded to a multiple of the float spacing at the range's
+// smallest magnitude. Either way a coordinate read as float minus the origin is again a float,
+// exactly, so the mesher decides on the very coordinates the output holds (its crossing test
+// depends on it), while georeferenced coordinates keep their precision.
+inline double frame_origin(double lo, double hi) {
+  const double width = hi - lo;
+  const double near = std::min(std::abs(lo - width), std::abs(hi + width));
+  if ((lo - width <= 0 && hi + width >= 0) || !(2 * width < near)) return 0;
+  int exponent = 0;
+  std::frexp(near, &exponent);  // near = f * 2^exponent, f in [0.5, 1)
+  const double step = std::ldexp(1.0, exponent - 24);
+  return std::round(0.5 * (lo + hi) / step) * step;
+}
+
 inline double box_distance(const TileBox& box, const double* p) {
   double d2 = 0;
   for (int a = 0; a < 3; ++a) {

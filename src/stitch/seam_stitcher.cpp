@@ -71,7 +71,7 @@ class SeamStitcher {
       ids_.push_back(id);
       growable_.push_back(s != IdMap::kMissing);
       for (int a = 0; a < 3; ++a) {
-        local_.push_back(static_cast<float>(p[a] - 0.5 * (box.lo[a] + box.hi[a])));
+        local_.push_back(static_cast<float>(p[a] - frame_origin(box.lo[a], box.hi[a])));
       }
     };
     {
@@ -136,8 +136,9 @@ class SeamStitcher {
 
     MeshOptions mesh_options = options_.mesh;
     mesh_options.progress = {};
-    GrowResult grown = grow_mesh(
-        grid, mesh_options, {preload_, preload_group_, growable, links_, options_.stitch_retries});
+    GrowResult grown =
+        grow_mesh(grid, mesh_options,
+                  {preload_, preload_group_, growable, links_, options_.stitch_retries, {}});
 
     // Orientation: per grower group, the first preloaded triangle anchors it to a live group.
     const std::size_t preloaded = preload_.size();

@@ -86,6 +86,7 @@ TEST(RealScanGaps, ClosingGapsLeavesFewerHolesAndNoDefect) {
     for (const bool close : {false, true}) {
       g2s::MeshOptions options;
       options.close_gaps = close;
+      if (!close) options.max_hole_edges = 0;
       g2s::TileMesh mesh = g2s::mesh_cloud(cloud, options);
       s[close] = g2s::compute_stats({cloud.xyz, std::move(mesh.triangles)}, &cloud);
       EXPECT_EQ(s[close].non_manifold_edges, 0u);
@@ -110,11 +111,11 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(Baseline{"closed-kitten", true, 0.995, 0, 0},
                       Baseline{"closed-bunny-zipper", true, 0.995, 60, 5},
                       Baseline{"open-bunny-scan-bun000", false, 0.998, 775, 15},
-                      Baseline{"raw-bunny", false, 0.992, 46100, 5560},
+                      Baseline{"raw-bunny", false, 0.990, 46100, 5560},
                       Baseline{"open-table-mug-stereo", false, 0.992, 10470, 870},
                       Baseline{"open-lion-photogrammetry", false, 0.995, 26060, 1825},
                       Baseline{"open-autzen-lidar", false, 0.991, 12560, 606},
-                      Baseline{"open-alpe-selle-photogrammetry", false, 0.987, 2937000, 101200}),
+                      Baseline{"open-alpe-selle-photogrammetry", false, 0.985, 2937000, 101200}),
     [](const ::testing::TestParamInfo<Baseline>& param) {
       std::string name = param.param.name;
       for (char& c : name) {

@@ -47,7 +47,8 @@ GapRun grow_around_gap(bool close_gaps) {
   for (Index v : {0, 1, 2}) growable[at[v]] = 1;  // the outer corners and D are context
   g2s::MeshOptions options;
   options.close_gaps = close_gaps;
-  g2s::GrowResult r = g2s::grow_mesh(grid, options, {preload, labels, growable, {}, 0});
+  if (!close_gaps) options.max_hole_edges = 0;  // hole filling would close the gap as well
+  g2s::GrowResult r = g2s::grow_mesh(grid, options, {preload, labels, growable, {}, 0, {}});
   GapRun run;
   for (const Triangle& t : r.triangles) {
     run.grown.push_back({grid.id(t[0]), grid.id(t[1]), grid.id(t[2])});
@@ -90,7 +91,8 @@ TEST(GapClosing, AGapIsNotClosedWhereItWouldFold) {
   const std::vector<Triangle> preload{
       {at[0], at[1], at[3]}, {at[1], at[2], at[3]}, {at[2], at[0], at[3]}};
   const std::vector<std::uint32_t> labels{0, 0, 0};
-  const g2s::GrowResult r = g2s::grow_mesh(grid, g2s::MeshOptions{}, {preload, labels, {}, {}, 0});
+  const g2s::GrowResult r =
+      g2s::grow_mesh(grid, g2s::MeshOptions{}, {preload, labels, {}, {}, 0, {}});
   EXPECT_TRUE(r.triangles.empty());
 }
 
