@@ -17,6 +17,9 @@ cloud, the tile store and the output, prints a Markdown table with an extrapolat
 and writes bench/results/<UTC date>-<commit>-memory.{json,md,png} (the chart with gnuplot, as
 bench/run.py draws its charts). The peaks of the largest and the smallest size should differ by
 less than 15%, all stay under the budget plus 15%, and the throughputs differ by less than 20%.
+`--with RESULT.json` adds the sizes of earlier runs of the same settings to the table, the
+comparisons and the chart (`--points '' --with A.json --with B.json` only combines them), so a
+long size can be measured on its own.
 Python 3 standard library only; needs GNU time.
 """
 
@@ -99,8 +102,8 @@ def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--build", default="build", help="build folder with g2s (default: build)")
     p.add_argument("--points", default="10M,40M,160M",
-                   type=lambda s: [count(x) for x in s.split(",")],
-                   help="cloud sizes (default 10M,40M,160M)")
+                   type=lambda s: [count(x) for x in s.split(",") if x.strip()],
+                   help="cloud sizes (default 10M,40M,160M; empty with --with to only combine)")
     p.add_argument("--shape", default="terrain", help="g2s synth shape (default terrain)")
     p.add_argument("--noise", type=float, default=0.1,
                    help="g2s synth --noise, sigma in mean spacings (default 0.1)")
@@ -114,9 +117,9 @@ def main():
     p.add_argument("--keep-clouds", action="store_true",
                    help="keep each cloud in --work for the next run (default: delete it)")
     p.add_argument("--out", default="bench/results", help="result folder")
-    p.add_argument("--with", dest="earlier", metavar="RESULT.json",
+    p.add_argument("--with", dest="earlier", metavar="RESULT.json", action="append", default=[],
                    help="an earlier result of this script with the same cloud and budget: its "
-                        "sizes join this run's table, comparisons and chart")
+                        "sizes join this run's table, comparisons and chart (may be repeated)")
     args = p.parse_args()
     g2s = (REPO / args.build / "g2s").resolve()
     if not g2s.exists():
@@ -130,13 +133,15 @@ def main():
     work.mkdir(parents=True, exist_ok=True)
     cloud_name = f"{args.shape}-noise{args.noise:g}-outliers{args.outliers:g}"
     rows = []
-    if args.earlier:
-        earlier = json.loads(Path(args.earlier).read_text())
+    for result in args.earlier:
+        earlier = json.loads(Path(result).read_text())
         same = [(earlier.get(k), getattr(args, k)) for k in ("shape", "noise", "outliers", "memory",
                                                              "threads")]
         if any(a != b for a, b in same):
-            sys.exit(f"bench/memory.py: {args.earlier} was measured with other settings: {same}")
-        rows = earlier["rows"]
+            sys.exit(f"bench/memory.py: {result} was measured with other settings: {same}")
+        rows += [dict(r, commit=earlier["commit"], date=earlier["date"]) for r in earlier["rows"]]
+    if not args.points and not rows:
+        sys.exit("bench/memory.py: nothing to measure (--points) or combine (--with)")
     for points in args.points:
         cloud = work / f"{cloud_name}-{points}.ply"
         if not cloud.exists():
@@ -190,12 +195,16 @@ def main():
             cpu = line.split(":", 1)[1].strip()
             break
     now = datetime.datetime.now(datetime.timezone.utc)
+    for r in rows:
+        r.setdefault("commit", commit)
+        r.setdefault("date", now.isoformat())
     cloud_text = (f"`g2s synth {args.shape} --noise {args.noise:g} --outliers {args.outliers:g}`")
     lines = [f"g2s {commit}, {now:%Y-%m-%dT%H:%M:%SZ}; {platform.machine()}, {cpu}; "
              f"{cloud_text}; `g2s mesh --memory {args.memory} --threads {args.threads}`, "
              f"{args.runs} run(s)",
              "",
-             "Measured:",
+             "Measured" + (" (rows of " + ", ".join(f"{Path(f).name}" for f in args.earlier) +
+                           " combined with this run)" if args.earlier else "") + ":",
              "",
              "| points | tiles | triangles | wall s | k-triangles/s | s per M triangles | "
              "peak RSS MB | peak live points | cloud GB | tile store GB | output GB | "
@@ -236,13 +245,13 @@ def main():
     else:
         print("gnuplot not found (bench/peers/install.sh installs it): no chart", file=sys.stderr)
     text = "\n".join(lines) + "\n"
-    print(text)
     stem.with_suffix(".md").write_text(text)
     stem.with_suffix(".json").write_text(json.dumps(
         {"commit": commit, "date": now.isoformat(), "cpu": cpu, "memory": args.memory,
          "threads": args.threads, "runs": args.runs, "with": args.earlier, "shape": args.shape, "noise": args.noise,
          "outliers": args.outliers, "rows": rows, "spread": spread, "rss_change": rss_change,
          "throughput_change": speed_change, "extrapolated": guess}, indent=1))
+    print(text)
 
 
 if __name__ == "__main__":
