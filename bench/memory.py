@@ -18,8 +18,9 @@ and writes bench/results/<UTC date>-<commit>-memory.{json,md,png} (the chart wit
 bench/run.py draws its charts). The peaks of the largest and the smallest size should differ by
 less than 15%, all stay under the budget plus 15%, and the throughputs differ by less than 20%.
 `--with RESULT.json` adds the sizes of earlier runs of the same settings to the table, the
-comparisons and the chart (`--points '' --with A.json --with B.json` only combines them), so a
-long size can be measured on its own.
+comparisons and the chart (a size measured again, later or by this run, replaces the earlier
+row; `--points '' --with A.json --with B.json` only combines), so a long size can be measured
+on its own.
 Python 3 standard library only; needs GNU time.
 """
 
@@ -139,7 +140,10 @@ def main():
                                                              "threads")]
         if any(a != b for a, b in same):
             sys.exit(f"bench/memory.py: {result} was measured with other settings: {same}")
+        # A size measured again (in a later file, or by this run) replaces the earlier row.
+        rows = [r for r in rows if r["points"] not in {e["points"] for e in earlier["rows"]}]
         rows += [dict(r, commit=earlier["commit"], date=earlier["date"]) for r in earlier["rows"]]
+    rows = [r for r in rows if r["points"] not in args.points]
     if not args.points and not rows:
         sys.exit("bench/memory.py: nothing to measure (--points) or combine (--with)")
     for points in args.points:
