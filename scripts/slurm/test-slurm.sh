@@ -45,19 +45,20 @@ chmod 0700 "$work"
 pids=()
 teardown() {
   local status=$?
-  # Cancel what is left, then stop the daemons we started (their own pids, nothing else).
+  # Cancel what is left and let the jobs' step daemons (slurmstepd) end with them, then stop the
+  # daemons we started (their own pids, nothing else).
   if [[ -f "$work/slurm.conf" ]] && ((${#pids[@]})); then
-    SLURM_CONF="$work/slurm.conf" timeout 10 scancel --quiet --user=root 2>/dev/null || true
+    export SLURM_CONF="$work/slurm.conf"
+    timeout 10 scancel --quiet --user=root 2>/dev/null || true
+    for _ in $(seq 100); do
+      [[ -z "$(timeout 5 squeue -h 2>/dev/null)" ]] && break
+      sleep 0.1
+    done
   fi
   for ((i = ${#pids[@]} - 1; i >= 0; i--)); do kill "${pids[i]}" 2>/dev/null || true; done
   for pid in "${pids[@]}"; do
     for _ in $(seq 50); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
     kill -9 "$pid" 2>/dev/null || true
-  done
-  # slurmd's job step managers (slurmstepd) leave with the jobs; wait for ours to be gone.
-  for _ in $(seq 50); do
-    pgrep -f "slurmstepd.*$work" >/dev/null 2>&1 || break
-    sleep 0.1
   done
   if ((status != 0)) && [[ -d "$work/log" ]]; then
     for log in "$work"/log/*; do echo "--- $log" >&2; tail -n 20 "$log" >&2; done
