@@ -115,12 +115,12 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
   const auto grow_start = std::chrono::steady_clock::now();
   MeshOptions mesh_options = options.mesh;
   mesh_options.progress = {};  // tiles grow in parallel; the pipeline reports per tile
-  // Holes are filled here only among the points no seam reaches; the seams fill the others.
-  const double fill_depth = seam_depth(tiles, tile, options);
+  // Holes are filled here among the tile's own points (a filling of them lies in the box); the
+  // seams fill those that reach across.
   std::vector<std::uint8_t> fillable(grid.size(), 0);
   for (std::uint32_t k = 0; k < grid.size(); ++k) {
     const std::uint32_t s = grid.source(k);
-    fillable[k] = s < own && box_depth(box, &points.xyz[3 * std::size_t{s}]) > fill_depth;
+    fillable[k] = s < own;
   }
   GrowContext context;
   context.fillable = fillable;
