@@ -1,6 +1,6 @@
 // Defect measurement of any triangle mesh (src/stats/), as defined in ALGORITHM.md §8.
 // Linear time in the number of triangles (hash tables and a vertex->triangle table, no sorting),
-// single-threaded and deterministic.
+// deterministic; the self-intersection test runs in parallel.
 #pragma once
 
 #include <cstdint>
@@ -23,6 +23,11 @@ struct MeshStats {
   std::uint64_t non_manifold_vertices_type2 = 0;  // all fans open
   std::uint64_t holes = 0;                        // cycle rank of the boundary-edge graph
   std::uint64_t components = 0;                   // triangles sharing a vertex are connected
+  // Self-intersections: pairs of kept triangles whose closed triangles meet other than in the
+  // corners or the edge they share (folded flat onto a shared edge, or crossing elsewhere).
+  std::uint64_t crossing_pairs = 0;
+  std::uint64_t crossing_pairs_no_shared_vertex = 0;  // of those, pairs with no vertex in common
+  std::uint64_t crossing_triangles = 0;               // triangles in at least one crossing pair
   // With input points: share of them whose coordinates, rounded to float, are a vertex.
   bool has_coverage = false;
   std::uint64_t input_points = 0;
@@ -33,13 +38,18 @@ struct MeshStats {
 // Measures a mesh, in this order:
 // - Welding: corners are merged by exact equality of their three double coordinates (-0.0 equals
 //   0.0), so a mesh read from STL and the same mesh held indexed give the same numbers.
-// - Degenerate triangles (two equal welded corners, or a cross product of exactly zero computed
-//   in double) are counted and then left out of every other count except `triangles`: their
-//   corners count as vertices, join components and cover points only through other triangles.
+// - Degenerate triangles (two equal welded corners, or three exactly collinear corners, decided
+//   by exact predicates) are counted and then left out of every other count except `triangles`:
+//   their corners count as vertices, join components and cover points only through other triangles.
 // - Duplicates (a later triangle with the vertex set of an earlier one, either orientation) are
 //   counted; the first copy in input order is kept and the others are left out of the edge,
 //   vertex and fan counts. So a reversed copy listed first can turn into orientation conflicts.
 // - Edges, fans, holes and components are then counted on what is left, as in MeshStats.
+// - Crossings: every pair of kept triangles (not degenerate, not a duplicate copy, finite
+//   coordinates) is tested exactly, without tolerance: two triangles cross when the closed
+//   triangles share a point that is not a corner or edge they share (docs/algorithm.md, "Mesh
+//   statistics"). Candidate pairs come from a grid of the triangles' boxes; this part runs in
+//   parallel in the caller's TBB arena, with the same counts for any thread count.
 // - Coverage, when input_points is given: an input point is covered when a vertex of a kept
 //   triangle has the same coordinates after both are rounded to float, because STL stores
 //   float32 and an STL mesh of a double-precision cloud must still cover it. Every given point

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <limits>
@@ -19,20 +20,13 @@
 #include <sys/mman.h>
 #endif
 
+#include "common/exact_predicates.hpp"
+#include "common/mix64.hpp"
 #include "g2s/error.hpp"
+#include "stats/self_intersections.hpp"
 
 namespace g2s {
 namespace {
-
-// splitmix64's finaliser: spreads every input bit over the whole word.
-std::uint64_t mix64(std::uint64_t x) {
-  x ^= x >> 30;
-  x *= 0xbf58476d1ce4e5b9ULL;
-  x ^= x >> 27;
-  x *= 0x94d049bb133111ebULL;
-  x ^= x >> 31;
-  return x;
-}
 
 // A hint to start loading `p` into cache: the hash-table probes here are random accesses into
 // tables far larger than the cache, so each loop asks a few iterations ahead.
@@ -133,16 +127,18 @@ struct Welded {
   Table<Index> rep;
 };
 
-// Two equal welded corners, or three corners whose cross product is exactly zero in double.
+// Two equal welded corners, or three exactly collinear corners. A triangle with a NaN or infinite
+// coordinate is not degenerate (it has no defined shape); the crossing test leaves it out.
 bool is_degenerate(const Triangle& t, const Triangle& input, const double* xyz) {
   if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) return true;
-  const double* a = xyz + 3 * std::size_t{input[0]};
-  const double* b = xyz + 3 * std::size_t{input[1]};
-  const double* c = xyz + 3 * std::size_t{input[2]};
-  const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-  const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-  return u[1] * v[2] - u[2] * v[1] == 0.0 && u[2] * v[0] - u[0] * v[2] == 0.0 &&
-         u[0] * v[1] - u[1] * v[0] == 0.0;
+  const double* corner[3];
+  for (int k = 0; k < 3; ++k) {
+    corner[k] = xyz + 3 * std::size_t{input[k]};
+    for (int d = 0; d < 3; ++d) {
+      if (!std::isfinite(corner[k][d])) return false;
+    }
+  }
+  return exact::collinear(corner[0], corner[1], corner[2]);
 }
 
 // Welds the corners by exact position and drops (and counts) degenerate triangles. The position
@@ -487,6 +483,11 @@ MeshStats compute_stats(const IndexedMesh& mesh, const PointCloud* input_points)
     measure_stars<std::uint64_t>(welded.triangles, vertex_count, welded.rep, mesh, input_points,
                                  stats);
   }
+  const stats::CrossingCounts crossings =
+      stats::count_crossings(welded.triangles, mesh.xyz.data(), welded.rep);
+  stats.crossing_pairs = crossings.pairs;
+  stats.crossing_pairs_no_shared_vertex = crossings.pairs_no_shared_vertex;
+  stats.crossing_triangles = crossings.triangles;
   return stats;
 }
 

@@ -475,6 +475,9 @@ TEST(Stats, JsonHasEveryKeyInOrder) {
                         "holes",
                         "orientation_conflicts",
                         "components",
+                        "crossing_pairs",
+                        "crossing_pairs_no_shared_vertex",
+                        "crossing_triangles",
                         "input_points",
                         "covered_points",
                         "coverage"};
@@ -493,7 +496,7 @@ TEST(Stats, JsonHasEveryKeyInOrder) {
   const std::string plain = g2s::stats_to_json(g2s::compute_stats(tetrahedron()));
   EXPECT_EQ(plain.find("coverage"), std::string::npos);
   EXPECT_EQ(plain.find("input_points"), std::string::npos);
-  EXPECT_NE(plain.find("\"components\": 1\n}"), std::string::npos) << plain;
+  EXPECT_NE(plain.find("\"crossing_triangles\": 0\n}"), std::string::npos) << plain;
 }
 
 TEST(Stats, TextIsAligned) {
@@ -513,7 +516,7 @@ TEST(Stats, TextIsAligned) {
     start = end + 1;
     ++lines;
   }
-  EXPECT_EQ(lines, 15);
+  EXPECT_EQ(lines, 18);
 }
 
 // The command line: `g2s stats` on an ASCII STL written here (STL is a triangle soup, so this
