@@ -33,6 +33,21 @@ struct MeshStats {
   std::uint64_t input_points = 0;
   std::uint64_t covered_points = 0;
   double coverage = 0.0;
+  // With input points, also how far the points that are not vertices lie from the mesh: the
+  // distance to the nearest kept triangle, in units of the cloud's spacing (the median distance
+  // from a point to its nearest neighbour at another position, over up to 65,536 of the points).
+  // has_distances is false when the mesh has no kept triangle or the spacing is 0.
+  bool has_distances = false;
+  double spacing = 0.0;                 // in the cloud's units
+  std::uint64_t off_mesh_points = 0;    // input points that are not vertices (finite ones)
+  std::uint64_t off_mesh_within_1 = 0;  // of them, at most 1 spacing from the mesh
+  std::uint64_t off_mesh_within_2 = 0;  // at most 2 spacings (including the above)
+  std::uint64_t off_mesh_within_4 = 0;  // at most 4 spacings
+  std::uint64_t off_mesh_beyond_4 = 0;  // more than 4 spacings
+  double off_mesh_median = 0.0;         // quantiles of the distance, in spacings
+  double off_mesh_p90 = 0.0;
+  double off_mesh_p99 = 0.0;
+  double off_mesh_max = 0.0;
 };
 
 // Measures a mesh, in this order:
@@ -53,7 +68,8 @@ struct MeshStats {
 // - Coverage, when input_points is given: an input point is covered when a vertex of a kept
 //   triangle has the same coordinates after both are rounded to float, because STL stores
 //   float32 and an STL mesh of a double-precision cloud must still cover it. Every given point
-//   counts, duplicates included; coverage is 0 for an empty cloud.
+//   counts, duplicates included; coverage is 0 for an empty cloud. The points not covered are
+//   then measured against the mesh (see has_distances), in parallel.
 // Throws Error(bad_input) when a triangle indexes a vertex past the end of mesh.xyz.
 MeshStats compute_stats(const IndexedMesh& mesh, const PointCloud* input_points = nullptr);
 

@@ -23,6 +23,7 @@
 #include "common/exact_predicates.hpp"
 #include "common/mix64.hpp"
 #include "g2s/error.hpp"
+#include "stats/point_distances.hpp"
 #include "stats/self_intersections.hpp"
 
 namespace g2s {
@@ -296,7 +297,8 @@ class FloatPositionSet {
 // graph's cycles. Offset is the CSR offset type (32-bit when the table is small enough).
 template <typename Offset>
 void measure_stars(Table<Triangle>& triangles, std::size_t vertex_count, const Table<Index>& rep,
-                   const IndexedMesh& mesh, const PointCloud* input_points, MeshStats& stats) {
+                   const IndexedMesh& mesh, const PointCloud* input_points, MeshStats& stats,
+                   Table<std::uint64_t>& off_mesh) {
   // CSR vertex -> triangles, each star in input order.
   Table<Offset> offset(vertex_count + 1, 0);
   for (const Triangle& t : triangles) {
@@ -463,7 +465,11 @@ void measure_stars(Table<Triangle>& triangles, std::size_t vertex_count, const T
   stats.input_points = points;
   for (std::size_t i = 0; i < points; ++i) {
     if (i + kAhead < points) positions.prepare(point + 3 * (i + kAhead));
-    stats.covered_points += positions.contains(point + 3 * i) ? 1 : 0;
+    if (positions.contains(point + 3 * i)) {
+      ++stats.covered_points;
+    } else {
+      off_mesh.push_back(i);
+    }
   }
   stats.coverage =
       points == 0 ? 0.0 : static_cast<double>(stats.covered_points) / static_cast<double>(points);
@@ -475,19 +481,24 @@ MeshStats compute_stats(const IndexedMesh& mesh, const PointCloud* input_points)
   MeshStats stats;
   stats.triangles = mesh.triangles.size();
   Welded welded = weld(mesh, stats);
+  Table<std::uint64_t> off_mesh;  // input points that are not vertices
   const std::size_t vertex_count = welded.rep.size();
   if (3 * welded.triangles.size() < std::numeric_limits<std::uint32_t>::max()) {
     measure_stars<std::uint32_t>(welded.triangles, vertex_count, welded.rep, mesh, input_points,
-                                 stats);
+                                 stats, off_mesh);
   } else {
     measure_stars<std::uint64_t>(welded.triangles, vertex_count, welded.rep, mesh, input_points,
-                                 stats);
+                                 stats, off_mesh);
   }
   const stats::CrossingCounts crossings =
       stats::count_crossings(welded.triangles, mesh.xyz.data(), welded.rep);
   stats.crossing_pairs = crossings.pairs;
   stats.crossing_pairs_no_shared_vertex = crossings.pairs_no_shared_vertex;
   stats.crossing_triangles = crossings.triangles;
+  if (input_points != nullptr) {
+    stats::measure_point_distances(welded.triangles, mesh.xyz.data(), welded.rep, *input_points,
+                                   off_mesh, stats);
+  }
   return stats;
 }
 

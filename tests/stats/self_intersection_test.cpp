@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "common/exact_predicates.hpp"
@@ -435,3 +436,78 @@ TEST(StatsCrossings, GridAgreesWithAllPairs) {
 }
 
 }  // namespace
+
+// ---- Distances of the points left out ----
+
+// A 5 x 5 grid of points at spacing 1 in z = 0, meshed by two triangles over its corners only,
+// plus points above, beside and below it: the distances are known.
+TEST(StatsPointDistances, KnownDistancesInSpacings) {
+  const IndexedMesh mesh =
+      mesh_of({{0, 0, 0}, {4, 0, 0}, {4, 4, 0}, {0, 4, 0}}, {{0, 1, 2}, {0, 2, 3}});
+  g2s::PointCloud cloud;
+  for (int y = 0; y <= 4; ++y) {
+    for (int x = 0; x <= 4; ++x) cloud.xyz.insert(cloud.xyz.end(), {double(x), double(y), 0.0});
+  }
+  // 0.5, 1.5 and 3 above the middle, 5 beside the edge x = 4, 10 below the middle.
+  cloud.xyz.insert(cloud.xyz.end(), {2, 2, 0.5, 2, 2, 1.5, 2, 2, 3, 9, 2, 0, 2, 2, -10});
+  const g2s::MeshStats s = g2s::compute_stats(mesh, &cloud);
+  ASSERT_TRUE(s.has_distances);
+  EXPECT_EQ(s.covered_points, 4u);
+  EXPECT_DOUBLE_EQ(s.spacing, 1.0);  // 24 of the 30 nearest-neighbour distances are 1
+  EXPECT_EQ(s.off_mesh_points, 26u);
+  EXPECT_EQ(s.off_mesh_within_1, 22u);  // the 21 grid points in the mesh, and 0.5
+  EXPECT_EQ(s.off_mesh_within_2, 23u);
+  EXPECT_EQ(s.off_mesh_within_4, 24u);
+  EXPECT_EQ(s.off_mesh_beyond_4, 2u);
+  EXPECT_DOUBLE_EQ(s.off_mesh_median, 0.0);
+  EXPECT_DOUBLE_EQ(s.off_mesh_max, 10.0);
+  EXPECT_DOUBLE_EQ(s.off_mesh_p99, 5.0);  // the 25th of 26 sorted distances
+
+  const std::string json = g2s::stats_to_json(s);
+  EXPECT_NE(json.find("\"off_mesh_beyond_4_spacings\": 2,"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"off_mesh_distance_max\": 10\n}"), std::string::npos) << json;
+  EXPECT_FALSE(g2s::compute_stats(mesh).has_distances);
+}
+
+// Distances through the tree equal those to every triangle, on a random soup and random points.
+TEST(StatsPointDistances, TreeAgreesWithEveryTriangle) {
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> position(0.0, 10.0), offset(-0.5, 0.5);
+  IndexedMesh mesh;
+  for (int t = 0; t < 400; ++t) {
+    const double cx = position(rng), cy = position(rng), cz = position(rng);
+    for (int c = 0; c < 3; ++c) {
+      mesh.xyz.insert(mesh.xyz.end(), {cx + offset(rng), cy + offset(rng), cz + offset(rng)});
+    }
+    const auto base = static_cast<Index>(3 * t);
+    mesh.triangles.push_back({base, base + 1, base + 2});
+  }
+  g2s::PointCloud cloud;
+  for (int i = 0; i < 300; ++i) {
+    cloud.xyz.insert(cloud.xyz.end(), {3 * position(rng) - 10, position(rng), position(rng)});
+  }
+  const g2s::MeshStats s = g2s::compute_stats(mesh, &cloud);
+  ASSERT_TRUE(s.has_distances);
+  ASSERT_EQ(s.off_mesh_points, 300u);
+  // The largest distance, by brute force over the triangles (sampled densely enough to be within
+  // 1% of the exact one; the exact one is never larger than any sample).
+  double largest = 0.0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Vec3 p(cloud.xyz[3 * i], cloud.xyz[3 * i + 1], cloud.xyz[3 * i + 2]);
+    double best = 1e300;
+    for (const Triangle& t : mesh.triangles) {
+      const Vec3 a(mesh.xyz[3 * t[0]], mesh.xyz[3 * t[0] + 1], mesh.xyz[3 * t[0] + 2]);
+      const Vec3 b(mesh.xyz[3 * t[1]], mesh.xyz[3 * t[1] + 1], mesh.xyz[3 * t[1] + 2]);
+      const Vec3 c(mesh.xyz[3 * t[2]], mesh.xyz[3 * t[2] + 1], mesh.xyz[3 * t[2] + 2]);
+      for (int u = 0; u <= 40; ++u) {
+        for (int v = 0; u + v <= 40; ++v) {
+          const Vec3 q = a + (b - a) * (u / 40.0) + (c - a) * (v / 40.0);
+          best = std::min(best, g2s::norm(q - p));
+        }
+      }
+    }
+    largest = std::max(largest, best);
+  }
+  EXPECT_LE(s.off_mesh_max * s.spacing, largest * (1 + 1e-12));
+  EXPECT_GE(s.off_mesh_max * s.spacing, largest * 0.99);
+}
