@@ -14,6 +14,7 @@
 // when their third corners lie on the same side of it.
 #include "common/triangle_intersection.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "common/exact_predicates.hpp"
@@ -49,8 +50,8 @@ void projection_plane(Point p0, Point p1, Point p2, int& i, int& j, int& orienta
 // Closed segments [a, b] and [c, d], collinear with each other, overlap: their boxes overlap.
 bool collinear_overlap(Point a, Point b, Point c, Point d, int i, int j) {
   for (const int k : {i, j}) {
-    if (std::fmax(a[k], b[k]) < std::fmin(c[k], d[k])) return false;
-    if (std::fmax(c[k], d[k]) < std::fmin(a[k], b[k])) return false;
+    if (std::max(a[k], b[k]) < std::min(c[k], d[k])) return false;
+    if (std::max(c[k], d[k]) < std::min(a[k], b[k])) return false;
   }
   return true;
 }
@@ -94,10 +95,10 @@ bool segment_meets_triangle(Point s, Point t, int s_side, int t_side, const Poin
 
 bool boxes_apart(const Point a[3], const Point b[3]) {
   for (int k = 0; k < 3; ++k) {
-    const double a_min = std::fmin(a[0][k], std::fmin(a[1][k], a[2][k]));
-    const double a_max = std::fmax(a[0][k], std::fmax(a[1][k], a[2][k]));
-    const double b_min = std::fmin(b[0][k], std::fmin(b[1][k], b[2][k]));
-    const double b_max = std::fmax(b[0][k], std::fmax(b[1][k], b[2][k]));
+    const double a_min = std::min({a[0][k], a[1][k], a[2][k]});
+    const double a_max = std::max({a[0][k], a[1][k], a[2][k]});
+    const double b_min = std::min({b[0][k], b[1][k], b[2][k]});
+    const double b_max = std::max({b[0][k], b[1][k], b[2][k]});
     if (a_max < b_min || b_max < a_min) return true;
   }
   return false;
