@@ -20,10 +20,13 @@ namespace g2s {
 // - a shared edge: they are coplanar and lie on the same side of the edge (folded flat onto
 //   each other); otherwise they meet only in the edge;
 // - three shared corners: always (the same triangle twice).
-// Cost: a bounding-box test (18 comparisons), then 3 filtered orient3d (about 40 flops each) to
-// reject a triangle lying on one side of the other's plane; at most 2 + 24 orient3d when the
-// planes cross. The exact fallback (a few microseconds) runs only for near-degenerate
-// configurations.
+// Cost: a bounding-box test (18 comparisons) first; then, without shared corners, 3 filtered
+// orient3d (about 40 flops each) reject a triangle lying on one side of the other's plane, and
+// at most 24 run when the planes cross; with one shared corner 4 to 10, with a shared edge 1.
+// No allocation. Measured (bench/stats_bench.cpp, BM_TrianglesCross, CPU time on a loaded
+// machine) on float triangles of a sphere's mesh against the next 16 in mesher order: about 14 ns
+// a call on average, 46 ns on the pairs whose boxes overlap (mostly neighbours). The exact
+// fallback (about a microsecond) runs only for nearly degenerate configurations.
 bool triangles_cross(const double* const a[3], const double* const b[3]);
 bool triangles_cross(const Vec3 a[3], const Vec3 b[3]);
 bool triangles_cross(const Vec3f a[3], const Vec3f b[3]);
