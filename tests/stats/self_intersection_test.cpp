@@ -2,6 +2,7 @@
 // inputs), of the triangle-pair crossing test (hand-made pairs with known answers) and of the
 // crossing counts of compute_stats (hand-made meshes; a random soup against all pairs).
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
@@ -402,6 +403,14 @@ TEST(StatsCrossings, GridAgreesWithAllPairs) {
     mesh.triangles.push_back({base, base + 1, base + 2});
   }
   const g2s::MeshStats s = g2s::compute_stats(mesh);
+  // The same counts on one thread and on three (the caller's arena is respected).
+  for (const int threads : {1, 3}) {
+    tbb::task_arena arena(threads);
+    const g2s::MeshStats t = arena.execute([&] { return g2s::compute_stats(mesh); });
+    EXPECT_EQ(t.crossing_pairs, s.crossing_pairs) << threads;
+    EXPECT_EQ(t.crossing_pairs_no_shared_vertex, s.crossing_pairs_no_shared_vertex) << threads;
+    EXPECT_EQ(t.crossing_triangles, s.crossing_triangles) << threads;
+  }
 
   // All pairs, sharing corners by position, as the stats weld them.
   std::vector<std::array<const double*, 3>> kept;
