@@ -101,6 +101,7 @@ void measure_point_distances(std::span<const Triangle> triangles, const double* 
   stats.spacing = median_spacing(cloud);
   if (usable.empty() || !(stats.spacing > 0.0)) return;
   stats.has_distances = true;
+  if (off_mesh.empty()) return;  // every point is a vertex: nothing to measure
 
   const BoxTree tree(usable.size(), [&](std::size_t i) {
     const Triangle& tri = triangles[usable[i]];
