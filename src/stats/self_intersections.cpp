@@ -25,6 +25,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <vector>
 
 #include "common/mix64.hpp"
@@ -167,18 +168,15 @@ CrossingCounts count_crossings(std::span<const Triangle> triangles, const double
     const double side =
         std::max({static_cast<double>(b.hi[0]) - b.lo[0], static_cast<double>(b.hi[1]) - b.lo[1],
                   static_cast<double>(b.hi[2]) - b.lo[2]});
-    if (std::isfinite(side)) {
-      side_sum += side;
-      ++boxed;
-    }
+    if (!std::isfinite(side)) continue;  // beyond float's range: out of the grid below
+    side_sum += side;
+    ++boxed;
     for (int k = 0; k < 3; ++k) origin[k] = std::min(origin[k], b.lo[k]);
   }
-  CrossingCounts result;
-  if (boxed == 0) return result;
   double cell = 3.0 * side_sum / static_cast<double>(boxed);
   if (!(cell > 0.0) || !std::isfinite(cell)) cell = 1.0;
 
-  // Cells per triangle (0: out of the grid), then a bucket table about as large as the entries.
+  // Cells per triangle (0: out of the grid), then a bucket table half as large as the entries.
   Grid grid(origin, cell);
   std::vector<std::uint8_t> cells(count, 0);
   const std::uint64_t entries = tbb::parallel_reduce(
@@ -291,6 +289,7 @@ CrossingCounts count_crossings(std::span<const Triangle> triangles, const double
       },
       add_counts);
 
+  CrossingCounts result;
   result.pairs = total.pairs;
   result.pairs_no_shared_vertex = total.pairs_no_shared_vertex;
   for (const std::uint8_t flag : crossing) result.triangles += flag;

@@ -384,6 +384,24 @@ TEST(StatsCrossings, DuplicatesAndDegenerateTrianglesAreLeftOut) {
   EXPECT_EQ(s.crossing_triangles, 3u);
 }
 
+// Coordinates beyond float's range (the grid's boxes are float) are still compared, exactly.
+TEST(StatsCrossings, CoordinatesBeyondFloatRange) {
+  const double big = 1e39;
+  const IndexedMesh mesh = mesh_of({{0, 0, 0},
+                                    {4 * big, 0, 0},
+                                    {0, 4 * big, 0},
+                                    {big, big, -big},
+                                    {big, big, big},
+                                    {2 * big, big, big},
+                                    {10, 10, 10},
+                                    {11, 10, 10},
+                                    {10, 11, 10}},
+                                   {{0, 1, 2}, {3, 4, 5}, {6, 7, 8}});
+  const g2s::MeshStats s = g2s::compute_stats(mesh);
+  EXPECT_EQ(s.crossing_pairs, 1u);
+  EXPECT_EQ(s.crossing_triangles, 2u);
+}
+
 // A soup of random small triangles in a box, some big, some along one line: the grid's counts
 // must equal those of testing every pair.
 TEST(StatsCrossings, GridAgreesWithAllPairs) {
