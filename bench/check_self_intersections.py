@@ -12,7 +12,7 @@ scans made by `g2s mesh` and, where their drivers are built (-DG2S_BUILD_PEERS=O
 bench/peers/README.md), by PCL's greedy projection and Open3D's ball pivoting. Prints a Markdown
 table; exit status 1 when any count differs, 2 when a tool is missing.
 
-    bench/check_self_intersections.py [--g2s build/g2s] [--peers build-peers/bench/peers]
+    bench/check_self_intersections.py [--g2s build/g2s] [--peers build-bench/bench/peers]
         [--data ../shared/data] [--work /tmp/g2s-check-si] [--scans a,b,...] [--no-scans] [MESH...]
 """
 import argparse
@@ -70,7 +70,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("meshes", nargs="*", help="extra meshes (STL, PLY) to check")
     parser.add_argument("--g2s", default=str(ROOT / "build" / "g2s"))
-    parser.add_argument("--peers", default=str(ROOT / "build-peers" / "bench" / "peers"))
+    parser.add_argument("--peers", default=str(ROOT / "build-bench" / "bench" / "peers"))
     parser.add_argument("--data", default=os.environ.get("G2S_DATA_DIR",
                                                          str(ROOT.parent / "shared" / "data")))
     parser.add_argument("--work", default="/tmp/g2s-check-self-intersections")
