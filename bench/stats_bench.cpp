@@ -5,8 +5,12 @@
 // timed loops.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cstdint>
+#include <utility>
+#include <vector>
 
+#include "common/triangle_intersection.hpp"
 #include "g2s/mesher.hpp"
 #include "g2s/stats.hpp"
 #include "g2s/synth.hpp"
@@ -53,5 +57,50 @@ BENCHMARK(BM_ComputeStats1M)
     ->Arg(1)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+// triangles_cross on the pairs the mesher would ask about: triangles of the sphere's mesh, as
+// float triangles, against the next 16 in mesher order (neighbours in space); with argument 1
+// only the pairs whose bounding boxes overlap (mostly sharing a corner or an edge). Items are
+// calls.
+void BM_TrianglesCross(benchmark::State& state) {
+  const Fixture& f = million_triangles();
+  constexpr std::size_t kTriangles = 20000, kNext = 16;
+  std::vector<g2s::Vec3f> tri(3 * kTriangles);
+  for (std::size_t t = 0; t < kTriangles; ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const double* p = &f.mesh.xyz[3 * std::size_t{f.mesh.triangles[t][k]}];
+      tri[3 * t + k] = {static_cast<float>(p[0]), static_cast<float>(p[1]),
+                        static_cast<float>(p[2])};
+    }
+  }
+  auto boxes_overlap = [&](std::size_t t, std::size_t u) {
+    for (int k = 0; k < 3; ++k) {
+      auto coordinate = [&](std::size_t i, int c) {
+        const g2s::Vec3f& v = tri[3 * i + c];
+        return k == 0 ? v.x : (k == 1 ? v.y : v.z);
+      };
+      const float t_lo = std::min({coordinate(t, 0), coordinate(t, 1), coordinate(t, 2)});
+      const float t_hi = std::max({coordinate(t, 0), coordinate(t, 1), coordinate(t, 2)});
+      const float u_lo = std::min({coordinate(u, 0), coordinate(u, 1), coordinate(u, 2)});
+      const float u_hi = std::max({coordinate(u, 0), coordinate(u, 1), coordinate(u, 2)});
+      if (t_hi < u_lo || u_hi < t_lo) return false;
+    }
+    return true;
+  };
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;
+  for (std::size_t t = 0; t + kNext < kTriangles; ++t) {
+    for (std::size_t u = t + 1; u <= t + kNext; ++u) {
+      if (state.range(0) == 0 || boxes_overlap(t, u)) pairs.emplace_back(t, u);
+    }
+  }
+  std::int64_t crossing = 0;
+  for (auto _ : state) {
+    for (const auto& [t, u] : pairs) crossing += g2s::triangles_cross(&tri[3 * t], &tri[3 * u]);
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(pairs.size()));
+  state.counters["pairs"] = static_cast<double>(pairs.size());
+  state.counters["crossing"] = static_cast<double>(crossing);
+}
+BENCHMARK(BM_TrianglesCross)->ArgName("overlapping")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -1,6 +1,6 @@
 // `g2s stats MESH [--points CLOUD] [--json] [--largest-component]`: measures a mesh's defects
-// (ALGORITHM.md §8), or those of its largest piece, and prints them as aligned text or one JSON
-// object. Defects are data: exit 0 whenever the mesh could be read and measured; unreadable
+// (docs/algorithm.md §9), or those of its largest piece, and prints them as aligned text or one
+// JSON object. Defects are data: exit 0 whenever the mesh could be read and measured; unreadable
 // input exits 3 through g2s::Error.
 #include <fmt/core.h>
 
@@ -49,11 +49,14 @@ void add_stats_command(CLI::App& app) {
       "stats",
       "Measure a triangle mesh (STL or PLY): triangles, vertices, degenerate and duplicate\n"
       "triangles, non-manifold edges and vertices, boundary edges, holes, orientation\n"
-      "conflicts, components; with --points, the share of the cloud's points used as vertices.\n"
+      "conflicts, components, crossing triangle pairs (exact); with --points, the share of the\n"
+      "cloud's points used as vertices and the distances of the others to the mesh.\n"
       "Exit 0 whenever the mesh was measured, whatever its defects.");
   cmd->add_option("MESH", args->mesh, "Mesh to measure (.stl binary or ASCII, .ply)")->required();
-  cmd->add_option("--points", args->points,
-                  "Input cloud (PLY, LAS, XYZ): adds its coverage, compared at float precision");
+  cmd->add_option(
+      "--points", args->points,
+      "Input cloud (PLY, LAS, XYZ): adds its coverage, compared at float precision, and the\n"
+      "distances of its other points to the mesh, in sampling spacings");
   cmd->add_flag("--json", args->json, "Print one JSON object instead of text");
   cmd->add_flag("--largest-component", args->largest,
                 "Measure only the largest connected piece (most triangles), e.g. a scan's own\n"

@@ -212,9 +212,9 @@ void write_and_report(const TileSource& source,
   if (measure) {
     fmt::print(stderr,
                "; non-manifold edges {}, non-manifold vertices {}, orientation conflicts {}, "
-               "boundary edges {}, holes {}",
+               "boundary edges {}, holes {}, crossing triangle pairs {}",
                stats.non_manifold_edges, stats.non_manifold_vertices, stats.orientation_conflicts,
-               stats.boundary_edges, stats.holes);
+               stats.boundary_edges, stats.holes, stats.crossing_pairs);
   } else if (!args.no_stats) {
     fmt::print(stderr,
                "; defects not measured: reading the mesh back would exceed --memory "

@@ -1,6 +1,6 @@
-// Defect measurement of any triangle mesh (src/stats/), as defined in ALGORITHM.md §8.
+// Defect measurement of any triangle mesh (src/stats/), as defined in docs/algorithm.md §9.
 // Linear time in the number of triangles (hash tables and a vertex->triangle table, no sorting),
-// single-threaded and deterministic.
+// deterministic; the self-intersection test runs in parallel.
 #pragma once
 
 #include <cstdint>
@@ -23,27 +23,53 @@ struct MeshStats {
   std::uint64_t non_manifold_vertices_type2 = 0;  // all fans open
   std::uint64_t holes = 0;                        // cycle rank of the boundary-edge graph
   std::uint64_t components = 0;                   // triangles sharing a vertex are connected
+  // Self-intersections: pairs of kept triangles whose closed triangles meet other than in the
+  // corners or the edge they share (folded flat onto a shared edge, or crossing elsewhere).
+  std::uint64_t crossing_pairs = 0;
+  std::uint64_t crossing_pairs_no_shared_vertex = 0;  // of those, pairs with no vertex in common
+  std::uint64_t crossing_triangles = 0;               // triangles in at least one crossing pair
   // With input points: share of them whose coordinates, rounded to float, are a vertex.
   bool has_coverage = false;
   std::uint64_t input_points = 0;
   std::uint64_t covered_points = 0;
   double coverage = 0.0;
+  // With input points, also how far the points that are not vertices lie from the mesh: the
+  // distance to the nearest kept triangle, in units of the cloud's spacing (the median distance
+  // from a point to its nearest neighbour at another position, over up to 65,536 of the points).
+  // has_distances is false when the mesh has no kept triangle or the spacing is 0.
+  bool has_distances = false;
+  double spacing = 0.0;                 // in the cloud's units
+  std::uint64_t off_mesh_points = 0;    // input points that are not vertices (finite ones)
+  std::uint64_t off_mesh_within_1 = 0;  // of them, at most 1 spacing from the mesh
+  std::uint64_t off_mesh_within_2 = 0;  // at most 2 spacings (including the above)
+  std::uint64_t off_mesh_within_4 = 0;  // at most 4 spacings
+  std::uint64_t off_mesh_beyond_4 = 0;  // more than 4 spacings
+  double off_mesh_median = 0.0;         // quantiles of the distance, in spacings
+  double off_mesh_p90 = 0.0;
+  double off_mesh_p99 = 0.0;
+  double off_mesh_max = 0.0;
 };
 
 // Measures a mesh, in this order:
 // - Welding: corners are merged by exact equality of their three double coordinates (-0.0 equals
 //   0.0), so a mesh read from STL and the same mesh held indexed give the same numbers.
-// - Degenerate triangles (two equal welded corners, or a cross product of exactly zero computed
-//   in double) are counted and then left out of every other count except `triangles`: their
-//   corners count as vertices, join components and cover points only through other triangles.
+// - Degenerate triangles (two equal welded corners, or three exactly collinear corners, decided
+//   by exact predicates) are counted and then left out of every other count except `triangles`:
+//   their corners count as vertices, join components and cover points only through other triangles.
 // - Duplicates (a later triangle with the vertex set of an earlier one, either orientation) are
 //   counted; the first copy in input order is kept and the others are left out of the edge,
 //   vertex and fan counts. So a reversed copy listed first can turn into orientation conflicts.
 // - Edges, fans, holes and components are then counted on what is left, as in MeshStats.
+// - Crossings: every pair of kept triangles (not degenerate, not a duplicate copy, finite
+//   coordinates) is tested exactly, without tolerance: two triangles cross when the closed
+//   triangles share a point that is not a corner or edge they share (docs/algorithm.md, "Mesh
+//   statistics"). Candidate pairs come from a grid of the triangles' boxes; this part runs in
+//   parallel in the caller's TBB arena, with the same counts for any thread count.
 // - Coverage, when input_points is given: an input point is covered when a vertex of a kept
 //   triangle has the same coordinates after both are rounded to float, because STL stores
 //   float32 and an STL mesh of a double-precision cloud must still cover it. Every given point
-//   counts, duplicates included; coverage is 0 for an empty cloud.
+//   counts, duplicates included; coverage is 0 for an empty cloud. The points not covered are
+//   then measured against the mesh (see has_distances), in parallel.
 // Throws Error(bad_input) when a triangle indexes a vertex past the end of mesh.xyz.
 MeshStats compute_stats(const IndexedMesh& mesh, const PointCloud* input_points = nullptr);
 

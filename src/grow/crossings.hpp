@@ -19,9 +19,9 @@
 
 namespace g2s::detail {
 
-// True when the closed triangles a and b intersect other than in corners or an edge they share
-// (corners are shared when their indices are equal). Triangles with equal corner sets, and
-// degenerate ones, never cross.
+// True when the closed triangles a and b (corner indices into points, which hold no two equal
+// positions) intersect other than in corners or an edge they share; exact
+// (common/triangle_intersection.hpp). The same triangle twice, and degenerate ones, never cross.
 bool triangles_cross(std::span<const Vec3f> points, const Triangle& a, const Triangle& b);
 
 // Triangles filed by the cell of their bounding box's lower corner, in two sizes of cell: a

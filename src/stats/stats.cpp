@@ -1,12 +1,13 @@
-// Mesh defect measurement (ALGORITHM.md §8): welds vertices by exact position, sets degenerate and
-// duplicate triangles aside, then walks every vertex's star once to count edges, fans and holes.
-// Linear time and lean memory: open-addressing hash tables on flat arrays, a CSR vertex->triangle
-// table and union-find, no sorting and no std::unordered_map.
+// Mesh defect measurement (docs/algorithm.md §9): welds vertices by exact position, sets degenerate
+// and duplicate triangles aside, then walks every vertex's star once to count edges, fans and
+// holes. Linear time and lean memory: open-addressing hash tables on flat arrays, a CSR
+// vertex->triangle table and union-find, no sorting and no std::unordered_map.
 #include "g2s/stats.hpp"
 
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <limits>
@@ -19,20 +20,14 @@
 #include <sys/mman.h>
 #endif
 
+#include "common/exact_predicates.hpp"
+#include "common/mix64.hpp"
 #include "g2s/error.hpp"
+#include "stats/point_distances.hpp"
+#include "stats/self_intersections.hpp"
 
 namespace g2s {
 namespace {
-
-// splitmix64's finaliser: spreads every input bit over the whole word.
-std::uint64_t mix64(std::uint64_t x) {
-  x ^= x >> 30;
-  x *= 0xbf58476d1ce4e5b9ULL;
-  x ^= x >> 27;
-  x *= 0x94d049bb133111ebULL;
-  x ^= x >> 31;
-  return x;
-}
 
 // A hint to start loading `p` into cache: the hash-table probes here are random accesses into
 // tables far larger than the cache, so each loop asks a few iterations ahead.
@@ -133,16 +128,18 @@ struct Welded {
   Table<Index> rep;
 };
 
-// Two equal welded corners, or three corners whose cross product is exactly zero in double.
+// Two equal welded corners, or three exactly collinear corners. A triangle with a NaN or infinite
+// coordinate is not degenerate (it has no defined shape); the crossing test leaves it out.
 bool is_degenerate(const Triangle& t, const Triangle& input, const double* xyz) {
   if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) return true;
-  const double* a = xyz + 3 * std::size_t{input[0]};
-  const double* b = xyz + 3 * std::size_t{input[1]};
-  const double* c = xyz + 3 * std::size_t{input[2]};
-  const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-  const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-  return u[1] * v[2] - u[2] * v[1] == 0.0 && u[2] * v[0] - u[0] * v[2] == 0.0 &&
-         u[0] * v[1] - u[1] * v[0] == 0.0;
+  const double* corner[3];
+  for (int k = 0; k < 3; ++k) {
+    corner[k] = xyz + 3 * std::size_t{input[k]};
+    for (int d = 0; d < 3; ++d) {
+      if (!std::isfinite(corner[k][d])) return false;
+    }
+  }
+  return exact::collinear(corner[0], corner[1], corner[2]);
 }
 
 // Welds the corners by exact position and drops (and counts) degenerate triangles. The position
@@ -300,7 +297,8 @@ class FloatPositionSet {
 // graph's cycles. Offset is the CSR offset type (32-bit when the table is small enough).
 template <typename Offset>
 void measure_stars(Table<Triangle>& triangles, std::size_t vertex_count, const Table<Index>& rep,
-                   const IndexedMesh& mesh, const PointCloud* input_points, MeshStats& stats) {
+                   const IndexedMesh& mesh, const PointCloud* input_points, MeshStats& stats,
+                   Table<std::uint64_t>& off_mesh) {
   // CSR vertex -> triangles, each star in input order.
   Table<Offset> offset(vertex_count + 1, 0);
   for (const Triangle& t : triangles) {
@@ -467,7 +465,11 @@ void measure_stars(Table<Triangle>& triangles, std::size_t vertex_count, const T
   stats.input_points = points;
   for (std::size_t i = 0; i < points; ++i) {
     if (i + kAhead < points) positions.prepare(point + 3 * (i + kAhead));
-    stats.covered_points += positions.contains(point + 3 * i) ? 1 : 0;
+    if (positions.contains(point + 3 * i)) {
+      ++stats.covered_points;
+    } else {
+      off_mesh.push_back(i);
+    }
   }
   stats.coverage =
       points == 0 ? 0.0 : static_cast<double>(stats.covered_points) / static_cast<double>(points);
@@ -479,13 +481,23 @@ MeshStats compute_stats(const IndexedMesh& mesh, const PointCloud* input_points)
   MeshStats stats;
   stats.triangles = mesh.triangles.size();
   Welded welded = weld(mesh, stats);
+  Table<std::uint64_t> off_mesh;  // input points that are not vertices
   const std::size_t vertex_count = welded.rep.size();
   if (3 * welded.triangles.size() < std::numeric_limits<std::uint32_t>::max()) {
     measure_stars<std::uint32_t>(welded.triangles, vertex_count, welded.rep, mesh, input_points,
-                                 stats);
+                                 stats, off_mesh);
   } else {
     measure_stars<std::uint64_t>(welded.triangles, vertex_count, welded.rep, mesh, input_points,
-                                 stats);
+                                 stats, off_mesh);
+  }
+  const stats::CrossingCounts crossings =
+      stats::count_crossings(welded.triangles, mesh.xyz.data(), welded.rep);
+  stats.crossing_pairs = crossings.pairs;
+  stats.crossing_pairs_no_shared_vertex = crossings.pairs_no_shared_vertex;
+  stats.crossing_triangles = crossings.triangles;
+  if (input_points != nullptr) {
+    stats::measure_point_distances(welded.triangles, mesh.xyz.data(), welded.rep, *input_points,
+                                   off_mesh, stats);
   }
   return stats;
 }

@@ -33,10 +33,39 @@ std::vector<Field> fields(const MeshStats& s) {
       {"holes", "holes", s.holes},
       {"orientation_conflicts", "orientation conflicts", s.orientation_conflicts},
       {"components", "components", s.components},
+      {"crossing_pairs", "crossing triangle pairs", s.crossing_pairs},
+      {"crossing_pairs_no_shared_vertex", "  sharing no vertex", s.crossing_pairs_no_shared_vertex},
+      {"crossing_triangles", "crossing triangles", s.crossing_triangles},
   };
   if (s.has_coverage) {
     out.push_back({"input_points", "input points", s.input_points});
     out.push_back({"covered_points", "covered points", s.covered_points});
+  }
+  if (s.has_distances) {
+    out.push_back({"off_mesh_points", "points off the mesh", s.off_mesh_points});
+    out.push_back({"off_mesh_within_1_spacing", "  within 1 spacing", s.off_mesh_within_1});
+    out.push_back({"off_mesh_within_2_spacings", "  within 2 spacings", s.off_mesh_within_2});
+    out.push_back({"off_mesh_within_4_spacings", "  within 4 spacings", s.off_mesh_within_4});
+    out.push_back({"off_mesh_beyond_4_spacings", "  beyond 4 spacings", s.off_mesh_beyond_4});
+  }
+  return out;
+}
+
+// The real-valued results of the point distances, after the counts: JSON key, label, value.
+struct Measure {
+  std::string_view key;
+  std::string_view label;
+  double value;
+};
+
+std::vector<Measure> measures(const MeshStats& s) {
+  std::vector<Measure> out;
+  if (s.has_distances) {
+    out = {{"spacing", "spacing", s.spacing},
+           {"off_mesh_distance_median", "median distance/spacing", s.off_mesh_median},
+           {"off_mesh_distance_p90", "90% distance/spacing", s.off_mesh_p90},
+           {"off_mesh_distance_p99", "99% distance/spacing", s.off_mesh_p99},
+           {"off_mesh_distance_max", "max distance/spacing", s.off_mesh_max}};
   }
   return out;
 }
@@ -52,6 +81,7 @@ std::string stats_to_json(const MeshStats& stats) {
   }
   // {} prints the shortest decimal that reads back as the same double: valid JSON, no NaN.
   if (stats.has_coverage) out += fmt::format(",\n  \"coverage\": {}", stats.coverage);
+  for (const Measure& m : measures(stats)) out += fmt::format(",\n  \"{}\": {}", m.key, m.value);
   out += "\n}";
   return out;
 }
@@ -62,6 +92,8 @@ std::string stats_to_text(const MeshStats& stats) {
   if (stats.has_coverage) {
     out += fmt::format("{:<26}{:>13.3f}%\n", "coverage", 100.0 * stats.coverage);
   }
+  for (const Measure& m : measures(stats))
+    out += fmt::format("{:<26}{:>14.4g}\n", m.label, m.value);
   return out;
 }
 

@@ -475,9 +475,22 @@ TEST(Stats, JsonHasEveryKeyInOrder) {
                         "holes",
                         "orientation_conflicts",
                         "components",
+                        "crossing_pairs",
+                        "crossing_pairs_no_shared_vertex",
+                        "crossing_triangles",
                         "input_points",
                         "covered_points",
-                        "coverage"};
+                        "off_mesh_points",
+                        "off_mesh_within_1_spacing",
+                        "off_mesh_within_2_spacings",
+                        "off_mesh_within_4_spacings",
+                        "off_mesh_beyond_4_spacings",
+                        "coverage",
+                        "spacing",
+                        "off_mesh_distance_median",
+                        "off_mesh_distance_p90",
+                        "off_mesh_distance_p99",
+                        "off_mesh_distance_max"};
   std::size_t last = 0;
   for (const char* key : keys) {
     const std::size_t at = json.find(std::string("\"") + key + "\":");
@@ -488,12 +501,12 @@ TEST(Stats, JsonHasEveryKeyInOrder) {
   EXPECT_EQ(json.front(), '{');
   EXPECT_EQ(json.back(), '}');
   EXPECT_NE(json.find("\"triangles\": 4,"), std::string::npos) << json;
-  EXPECT_NE(json.find("\"coverage\": 0.5\n"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"coverage\": 0.5,\n"), std::string::npos) << json;
 
   const std::string plain = g2s::stats_to_json(g2s::compute_stats(tetrahedron()));
   EXPECT_EQ(plain.find("coverage"), std::string::npos);
   EXPECT_EQ(plain.find("input_points"), std::string::npos);
-  EXPECT_NE(plain.find("\"components\": 1\n}"), std::string::npos) << plain;
+  EXPECT_NE(plain.find("\"crossing_triangles\": 0\n}"), std::string::npos) << plain;
 }
 
 TEST(Stats, TextIsAligned) {
@@ -513,7 +526,7 @@ TEST(Stats, TextIsAligned) {
     start = end + 1;
     ++lines;
   }
-  EXPECT_EQ(lines, 15);
+  EXPECT_EQ(lines, 28);
 }
 
 // The command line: `g2s stats` on an ASCII STL written here (STL is a triangle soup, so this

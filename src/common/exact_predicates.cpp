@@ -1,0 +1,206 @@
+// Exact orientation predicates (exact_predicates.hpp). The determinant is first evaluated in
+// double with an a-priori error bound (Shewchuk 1997, "Adaptive precision floating-point
+// arithmetic and fast robust geometric predicates", bounds A of orient2d and orient3d); only when
+// |det| is within the bound is it recomputed exactly as an expansion: a sum of doubles with
+// non-overlapping mantissas, in increasing magnitude, whose largest component has the sign of the
+// sum. Coordinate differences are kept exact as two-component expansions, products by Dekker's
+// splitting. Everything lives on the stack (at most 192 components for orient3d). This file is
+// compiled with -ffp-contract=off (CMakeLists.txt): a fused multiply-add would break the
+// error-free transformations.
+#include "common/exact_predicates.hpp"
+
+#include <cmath>
+
+namespace g2s::exact {
+namespace {
+
+constexpr double kEpsilon = 0x1p-53;  // half an ulp of 1: the unit roundoff
+constexpr double kSplitter = 0x1p27 + 1.0;
+constexpr double kOrient2dBound = (3.0 + 16.0 * kEpsilon) * kEpsilon;
+constexpr double kOrient3dBound = (7.0 + 56.0 * kEpsilon) * kEpsilon;
+
+// a + b = x + y exactly, x = fl(a + b).
+inline void two_sum(double a, double b, double& x, double& y) {
+  x = a + b;
+  const double b_virtual = x - a;
+  const double a_virtual = x - b_virtual;
+  y = (a - a_virtual) + (b - b_virtual);
+}
+
+// a - b = x + y exactly, x = fl(a - b).
+inline void two_diff(double a, double b, double& x, double& y) {
+  x = a - b;
+  const double b_virtual = a - x;
+  const double a_virtual = x + b_virtual;
+  y = (a - a_virtual) + (b_virtual - b);
+}
+
+// a = hi + lo with hi and lo of at most 26 significant bits each.
+inline void split(double a, double& hi, double& lo) {
+  const double c = kSplitter * a;
+  const double big = c - a;
+  hi = c - big;
+  lo = a - hi;
+}
+
+// a * b = x + y exactly, x = fl(a * b).
+inline void two_product(double a, double b, double& x, double& y) {
+  x = a * b;
+  double a_hi, a_lo, b_hi, b_lo;
+  split(a, a_hi, a_lo);
+  split(b, b_hi, b_lo);
+  const double err1 = x - a_hi * b_hi;
+  const double err2 = err1 - a_lo * b_hi;
+  const double err3 = err2 - a_hi * b_lo;
+  y = a_lo * b_lo - err3;
+}
+
+// An expansion on the stack: components in increasing magnitude, zeros eliminated (but at least
+// one component).
+template <int Capacity>
+struct Expansion {
+  double c[Capacity];
+  int n = 0;
+  int sign() const { return c[n - 1] > 0 ? 1 : (c[n - 1] < 0 ? -1 : 0); }
+};
+
+// e += b (Shewchuk's GROW-EXPANSION with zero elimination), in place.
+template <int Capacity>
+void grow(Expansion<Capacity>& e, double b) {
+  double q = b;
+  int out = 0;
+  for (int i = 0; i < e.n; ++i) {
+    double sum, error;
+    two_sum(q, e.c[i], sum, error);
+    q = sum;
+    if (error != 0.0) e.c[out++] = error;
+  }
+  if (q != 0.0 || out == 0) e.c[out++] = q;
+  e.n = out;
+}
+
+// e += f, one component of f at a time.
+template <int Capacity, int Other>
+void add(Expansion<Capacity>& e, const Expansion<Other>& f) {
+  for (int i = 0; i < f.n; ++i) grow(e, f.c[i]);
+}
+
+template <int Capacity>
+void negate(Expansion<Capacity>& e) {
+  for (int i = 0; i < e.n; ++i) e.c[i] = -e.c[i];
+}
+
+// out = e * b (Shewchuk's SCALE-EXPANSION with zero elimination).
+template <int Capacity, int Out>
+void scale(const Expansion<Capacity>& e, double b, Expansion<Out>& out) {
+  static_assert(Out >= 2 * Capacity);
+  double q, error;
+  two_product(e.c[0], b, q, error);
+  out.n = 0;
+  if (error != 0.0) out.c[out.n++] = error;
+  for (int i = 1; i < e.n; ++i) {
+    double product_hi, product_lo, sum;
+    two_product(e.c[i], b, product_hi, product_lo);
+    two_sum(q, product_lo, sum, error);
+    if (error != 0.0) out.c[out.n++] = error;
+    // |product_hi| >= |sum| here, so the fast two-sum would do; the plain one is as exact.
+    two_sum(product_hi, sum, q, error);
+    if (error != 0.0) out.c[out.n++] = error;
+  }
+  if (q != 0.0 || out.n == 0) out.c[out.n++] = q;
+}
+
+// out = e * f.
+template <int A, int B, int Out>
+void multiply(const Expansion<A>& e, const Expansion<B>& f, Expansion<Out>& out) {
+  static_assert(Out >= 2 * A * B);
+  out.n = 0;
+  Expansion<2 * A> partial;
+  for (int i = 0; i < f.n; ++i) {
+    scale(e, f.c[i], partial);
+    add(out, partial);
+  }
+  if (out.n == 0) out.c[out.n++] = 0.0;
+}
+
+// a - b, exactly.
+Expansion<2> difference(double a, double b) {
+  Expansion<2> d;
+  double x, y;
+  two_diff(a, b, x, y);
+  if (y != 0.0) d.c[d.n++] = y;
+  d.c[d.n++] = x;
+  return d;
+}
+
+// p * s - q * r for two-component p, q, r, s.
+Expansion<16> minor2(const Expansion<2>& p, const Expansion<2>& s, const Expansion<2>& q,
+                     const Expansion<2>& r) {
+  Expansion<16> out;
+  multiply(p, s, out);
+  Expansion<8> second;
+  multiply(q, r, second);
+  negate(second);
+  add(out, second);
+  return out;
+}
+
+int orient2d_exact(const double* a, const double* b, const double* c, int i, int j) {
+  const Expansion<2> ui = difference(b[i], a[i]), uj = difference(b[j], a[j]);
+  const Expansion<2> vi = difference(c[i], a[i]), vj = difference(c[j], a[j]);
+  return minor2(ui, vj, uj, vi).sign();
+}
+
+int orient3d_exact(const double* a, const double* b, const double* c, const double* d) {
+  Expansion<2> u[3], v[3], w[3];
+  for (int k = 0; k < 3; ++k) {
+    u[k] = difference(b[k], a[k]);
+    v[k] = difference(c[k], a[k]);
+    w[k] = difference(d[k], a[k]);
+  }
+  // det = w . (u x v), expanded along w.
+  Expansion<192> det;
+  Expansion<64> term;
+  for (int k = 0; k < 3; ++k) {
+    const int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+    multiply(minor2(u[k1], v[k2], u[k2], v[k1]), w[k], term);
+    add(det, term);
+  }
+  return det.sign();
+}
+
+}  // namespace
+
+int orient2d(const double* a, const double* b, const double* c, int i, int j) {
+  const double left = (b[i] - a[i]) * (c[j] - a[j]);
+  const double right = (b[j] - a[j]) * (c[i] - a[i]);
+  const double det = left - right;
+  const double bound = kOrient2dBound * (std::fabs(left) + std::fabs(right));
+  if (det > bound) return 1;
+  if (-det > bound) return -1;
+  return orient2d_exact(a, b, c, i, j);
+}
+
+int orient3d(const double* a, const double* b, const double* c, const double* d) {
+  const double ux = b[0] - a[0], uy = b[1] - a[1], uz = b[2] - a[2];
+  const double vx = c[0] - a[0], vy = c[1] - a[1], vz = c[2] - a[2];
+  const double wx = d[0] - a[0], wy = d[1] - a[1], wz = d[2] - a[2];
+  const double uyvz = uy * vz, uzvy = uz * vy;
+  const double uzvx = uz * vx, uxvz = ux * vz;
+  const double uxvy = ux * vy, uyvx = uy * vx;
+  const double det = wx * (uyvz - uzvy) + wy * (uzvx - uxvz) + wz * (uxvy - uyvx);
+  const double permanent = (std::fabs(uyvz) + std::fabs(uzvy)) * std::fabs(wx) +
+                           (std::fabs(uzvx) + std::fabs(uxvz)) * std::fabs(wy) +
+                           (std::fabs(uxvy) + std::fabs(uyvx)) * std::fabs(wz);
+  const double bound = kOrient3dBound * permanent;
+  if (det > bound) return 1;
+  if (-det > bound) return -1;
+  return orient3d_exact(a, b, c, d);
+}
+
+bool collinear(const double* a, const double* b, const double* c) {
+  return orient2d(a, b, c, 0, 1) == 0 && orient2d(a, b, c, 1, 2) == 0 &&
+         orient2d(a, b, c, 2, 0) == 0;
+}
+
+}  // namespace g2s::exact

@@ -1,0 +1,152 @@
+// Point-to-mesh distances of compute_stats (point_distances.hpp): how far the input points the
+// mesh leaves out lie from it, in sampling spacings, so that "left out but close to the surface"
+// can be told from "an outlier" or "a hole". Two box trees (box_tree.hpp), one over the cloud's
+// points for the spacing, one over the mesh's triangles for the distances, queried in parallel;
+// a point's distance to a triangle is that to its closest point, computed in double.
+#include "stats/point_distances.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "common/vec3.hpp"
+#include "stats/box_tree.hpp"
+
+namespace g2s::stats {
+namespace {
+
+constexpr std::size_t kSpacingSample = 65536;
+
+// The point of triangle a b c closest to p (Ericson, Real-Time Collision Detection, 5.1.5):
+// the vertex, edge or face region p projects into, from the signs of a few dot products.
+Vec3 closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Vec3 bp = p - b;
+  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
+  const Vec3 cp = p - c;
+  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
+    return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+  }
+  const double scale = 1.0 / (va + vb + vc);
+  return a + ab * (vb * scale) + ac * (vc * scale);
+}
+
+bool finite(const double* p) {
+  return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
+}
+
+Vec3 at(const double* p) {
+  return {p[0], p[1], p[2]};
+}
+
+// Median distance from every k-th point to its nearest point at another position.
+double median_spacing(const PointCloud& cloud) {
+  std::vector<std::uint32_t> points;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (finite(&cloud.xyz[3 * i])) points.push_back(static_cast<std::uint32_t>(i));
+  }
+  if (points.size() < 2) return 0.0;
+  const BoxTree tree(points.size(), [&](std::size_t i) {
+    const double* p = &cloud.xyz[3 * std::size_t{points[i]}];
+    return BoxTree::Box{{p[0], p[1], p[2]}, {p[0], p[1], p[2]}};
+  });
+  const std::size_t step = (points.size() + kSpacingSample - 1) / kSpacingSample;
+  std::vector<double> nearest((points.size() + step - 1) / step);
+  tbb::parallel_for(std::size_t{0}, nearest.size(), [&](std::size_t s) {
+    const double* q = &cloud.xyz[3 * std::size_t{points[s * step]}];
+    const Vec3 p = at(q);
+    nearest[s] = tree.nearest(q, [&](std::uint32_t i) {
+      const double d = norm(at(&cloud.xyz[3 * std::size_t{points[i]}]) - p);
+      return d == 0.0 ? -1.0 : d;
+    });
+  });
+  // Points whose every neighbour is at their own position have no spacing.
+  nearest.erase(
+      std::remove(nearest.begin(), nearest.end(), std::numeric_limits<double>::infinity()),
+      nearest.end());
+  if (nearest.empty()) return 0.0;
+  const auto middle = nearest.begin() + static_cast<std::ptrdiff_t>(nearest.size() / 2);
+  std::nth_element(nearest.begin(), middle, nearest.end());
+  return *middle;
+}
+
+}  // namespace
+
+void measure_point_distances(std::span<const Triangle> triangles, const double* xyz,
+                             std::span<const Index> rep, const PointCloud& cloud,
+                             std::span<const std::uint64_t> off_mesh, MeshStats& stats) {
+  auto corner = [&](Index w) { return xyz + 3 * std::size_t{rep[w]}; };
+  std::vector<std::uint32_t> usable;
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const Triangle& tri = triangles[t];
+    if (tri[0] != kNoIndex && finite(corner(tri[0])) && finite(corner(tri[1])) &&
+        finite(corner(tri[2]))) {
+      usable.push_back(static_cast<std::uint32_t>(t));
+    }
+  }
+  stats.spacing = median_spacing(cloud);
+  if (usable.empty() || !(stats.spacing > 0.0)) return;
+  stats.has_distances = true;
+  if (off_mesh.empty()) return;  // every point is a vertex: nothing to measure
+
+  const BoxTree tree(usable.size(), [&](std::size_t i) {
+    const Triangle& tri = triangles[usable[i]];
+    BoxTree::Box box;
+    for (int k = 0; k < 3; ++k) {
+      box.lo[k] = std::min({corner(tri[0])[k], corner(tri[1])[k], corner(tri[2])[k]});
+      box.hi[k] = std::max({corner(tri[0])[k], corner(tri[1])[k], corner(tri[2])[k]});
+    }
+    return box;
+  });
+  std::vector<double> distance(off_mesh.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, off_mesh.size(), 256), [&](const auto& r) {
+    for (std::size_t i = r.begin(); i < r.end(); ++i) {
+      const double* q = &cloud.xyz[3 * off_mesh[i]];
+      if (!finite(q)) {
+        distance[i] = std::numeric_limits<double>::quiet_NaN();
+        continue;
+      }
+      const Vec3 p = at(q);
+      distance[i] = tree.nearest(q, [&](std::uint32_t item) {
+        const Triangle& tri = triangles[usable[item]];
+        return norm(
+            closest_on_triangle(p, at(corner(tri[0])), at(corner(tri[1])), at(corner(tri[2]))) - p);
+      }) / stats.spacing;
+    }
+  });
+  distance.erase(
+      std::remove_if(distance.begin(), distance.end(), [](double d) { return std::isnan(d); }),
+      distance.end());
+  std::sort(distance.begin(), distance.end());
+  stats.off_mesh_points = distance.size();
+  for (const double d : distance) {
+    stats.off_mesh_within_1 += d <= 1.0;
+    stats.off_mesh_within_2 += d <= 2.0;
+    stats.off_mesh_within_4 += d <= 4.0;
+  }
+  stats.off_mesh_beyond_4 = distance.size() - stats.off_mesh_within_4;
+  auto quantile = [&](double q) {
+    if (distance.empty()) return 0.0;
+    return distance[static_cast<std::size_t>(q * static_cast<double>(distance.size() - 1))];
+  };
+  stats.off_mesh_median = quantile(0.5);
+  stats.off_mesh_p90 = quantile(0.9);
+  stats.off_mesh_p99 = quantile(0.99);
+  stats.off_mesh_max = quantile(1.0);
+}
+
+}  // namespace g2s::stats
