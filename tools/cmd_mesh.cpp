@@ -79,7 +79,7 @@ void warn_if_local_frame_rounds(const std::string& input, const TileStore& store
 
 void run_mesh(MeshArgs& args) {
   Progress progress(!args.out.quiet && !args.out.json);
-  RunFacts run{args.input, 0, 0, std::chrono::steady_clock::now()};
+  RunFacts run{args.input, 0, 0, std::chrono::steady_clock::now(), {}};
   std::unique_ptr<TemporaryPath> temporary;
   std::filesystem::path store_path = args.keep_store;
   if (store_path.empty()) {
@@ -101,7 +101,11 @@ void run_mesh(MeshArgs& args) {
     tiling.progress = [&](std::uint64_t done, std::uint64_t total) {
       progress.stage("tiling", total ? static_cast<double>(done) / static_cast<double>(total) : 1);
     };
+    const auto start = std::chrono::steady_clock::now();
+    const double cpu = cpu_seconds();
     read = build_tile_store(args.input, store_path, tiling).read;
+    run.tile = {std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+                cpu_seconds() - cpu};
   }
   const TileStore store(store_path);
   if (read.format.empty()) read = store.input_report();

@@ -115,7 +115,7 @@ void run_grow(GrowArgs& args) {
 
 void run_stitch(StitchArgs& args) {
   Progress progress(!args.out.quiet && !args.out.json);
-  RunFacts facts{args.store, 0, 0, std::chrono::steady_clock::now()};
+  RunFacts facts{args.store, 0, 0, std::chrono::steady_clock::now(), {}};
   const TileStore store(args.store);
   facts.non_finite = store.input_report().non_finite;
   const std::uint64_t fingerprint = source_fingerprint(store);

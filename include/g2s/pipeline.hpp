@@ -91,6 +91,10 @@ struct PipelineSummary {
   // The most points the stitcher held at once: the band of unfinished seams, not the cloud.
   std::uint64_t peak_live_points = 0;
   double seconds_stitch = 0.0;
+  // CPU seconds (thread clocks) of mesh_tiles' stages: growing, summed over the tiles, and the
+  // stitcher's intake of the tiles (seams, clean-up, and the sink's work as triangles go out).
+  double cpu_seconds_grow = 0.0;
+  double cpu_seconds_stitch = 0.0;
 };
 
 // The whole mesh in memory (tests, small clouds): triangles in global ids, oriented, manifold.

@@ -397,7 +397,10 @@ void Stitcher::add(std::size_t tile, TileGrowth growth) {
       const double* p = &points.xyz[3 * k];
       const std::uint32_t release = m.last_step(tile, p, later, inside, true);
       const bool listed = release != tile || box_depth(tiles[tile].box, p) <= unreachable;
-      if (!listed && !held[k]) continue;  // only in final triangles, or in none
+      if (!listed && !held[k]) {  // only in final triangles, or in none
+        if (number[k] != kNoIndex) m.sink.vertex_done(number[k]);
+        continue;
+      }
       const std::uint32_t finish =
           release == tile ? release : m.last_step(tile, p, later, inside, false);
       slot_of_point[k] = live.add_point(points.ids[k], p, finish, release, listed);
