@@ -4,14 +4,15 @@
 // reading the written file back (on the 6M-point alpine scan that read-back was a quarter of the
 // run and more than doubled the peak memory).
 //
-// What is held: the vertices not yet done (welded by their position as the file stores it) and
-// the triangles with a corner not yet done, each vertex's star as a list threaded through its
-// triangles. When a vertex is done its star is complete, so its fans are judged and its edges
-// counted, each edge at whichever end is done first (the other end is then still open). Holes
-// and components need union-find over vertices; a forest over the open vertices is enough, since
-// a done vertex joins nothing more, and it is rebuilt over the open vertices' roots whenever it
-// has grown to twice their number. Orientation conflicts between two groups depend on the flips
-// decided at the end: those edges are tallied per pair of groups and settled in finish().
+// What is held: the vertices not yet done, welded by their position as the file stores it, each
+// with its star as wedges (per triangle: the corners after and before it, and its group), so
+// judging a vertex reads only its own record. When a vertex is done its star is complete, so its
+// fans are judged and its edges counted; an edge has the same triangles seen from either end, so
+// edge classes are counted at both ends and halved. Holes and components need union-find over
+// vertices; a forest over the open vertices is enough, since a done vertex joins nothing more,
+// and it is rebuilt over the open vertices' roots whenever it has grown to twice their number.
+// Orientation conflicts between two groups depend on the flips decided at the end: those edges
+// are tallied per pair of groups and settled in finish().
 #include "g2s/stream_stats.hpp"
 
 #include <algorithm>
@@ -85,21 +86,23 @@ struct EdgeGroup {
 struct StreamStats::Impl {
   // An open vertex: welded by position; `rep` is the number of its first vertex, the name its
   // triangles use.
+  // A triangle as seen from one of its corners: the corners after and before it, and its group.
+  struct Wedge {
+    std::uint32_t next;
+    std::uint32_t prev;
+    std::uint32_t group;
+  };
+  static constexpr std::uint32_t kInlineWedges = 9;  // most stars fit (G2S: about 6)
   struct Open {
     double xyz[3];
     std::uint32_t rep;
     std::uint32_t refs;  // vertex numbers welded here and not yet done
-    std::uint32_t star;  // first triangle of its star (kNoIndex: none)
     std::uint32_t component;
-    std::uint32_t border;  // node in the boundary-edge graph
+    std::uint32_t border;    // node in the boundary-edge graph
+    std::uint32_t wedges;    // its star's triangles so far
+    std::uint32_t overflow;  // the list holding wedges past the inline ones (kNoIndex: none)
+    Wedge inline_wedges[kInlineWedges];
   };
-  struct Live {
-    Triangle corner;                    // rep numbers
-    std::array<std::uint32_t, 3> next;  // the next triangle in each corner's star
-    std::uint32_t group;
-    std::uint32_t open_corners;
-  };
-
   Impl(MeshSink& sink, bool rounded) : next(sink), float_positions(rounded) {}
 
   MeshSink& next;
@@ -114,17 +117,21 @@ struct StreamStats::Impl {
   IdMap open_of;                      // vertex number -> open vertex
   std::vector<std::uint32_t> welder;  // position hash table of open vertices (kNoIndex: empty)
   std::size_t welder_mask = 0;
-  std::vector<Live> live;
-  std::vector<std::uint32_t> free_live;
+  std::vector<std::vector<Wedge>> overflow;  // large stars' further wedges
+  std::vector<std::uint32_t> free_overflow;
   OpenUnionFind components;
   OpenUnionFind borders;
   std::uint64_t boundary_merges = 0;
+  // Edge classes counted at both ends of each edge (halved in finish()).
+  std::uint64_t boundary_ends = 0;
+  std::uint64_t conflict_ends = 0;
+  std::uint64_t non_manifold_ends = 0;
   // Two-triangle edges between different groups, per (lower group << 32 | higher): how many run
   // the same way and how many opposite ways before the flips.
   std::unordered_map<std::uint64_t, std::array<std::uint64_t, 2>> group_pairs;
 
   // Per-star scratch.
-  std::vector<std::uint32_t> star;
+  std::vector<Wedge> star;
   std::vector<EdgeGroup> groups;
   std::vector<std::uint32_t> group_next, group_prev, fan;
   std::vector<std::uint8_t> fan_open;
@@ -194,7 +201,8 @@ struct StreamStats::Impl {
       std::copy_n(p, 3, v.xyz);
       v.rep = number;
       v.refs = 0;
-      v.star = kNoIndex;
+      v.wedges = 0;
+      v.overflow = kNoIndex;
       v.component = components.add();
       v.border = borders.add();
       ++open_count;
@@ -230,20 +238,40 @@ struct StreamStats::Impl {
            u[0] * v[1] - u[1] * v[0] == 0.0;
   }
 
+  void for_each_wedge(const Open& v, const auto& visit) const {
+    const std::uint32_t held = std::min(v.wedges, kInlineWedges);
+    for (std::uint32_t k = 0; k < held; ++k) visit(v.inline_wedges[k]);
+    if (v.overflow != kNoIndex) {
+      for (const Wedge& w : overflow[v.overflow]) visit(w);
+    }
+  }
+
+  void add_wedge(Open& v, const Wedge& w) {
+    if (v.wedges < kInlineWedges) {
+      v.inline_wedges[v.wedges++] = w;
+      return;
+    }
+    if (v.overflow == kNoIndex) {
+      if (free_overflow.empty()) {
+        v.overflow = static_cast<std::uint32_t>(overflow.size());
+        overflow.emplace_back();
+      } else {
+        v.overflow = free_overflow.back();
+        free_overflow.pop_back();
+      }
+    }
+    overflow[v.overflow].push_back(w);
+    ++v.wedges;
+  }
+
   // A later copy of a vertex set already in the star of its first corner.
   bool duplicate(const Triangle& rep, std::uint32_t first) const {
-    const auto sorted = [](Triangle t) {
-      std::sort(t.begin(), t.end());
-      return t;
-    };
-    const Triangle key = sorted(rep);
-    for (std::uint32_t t = open[first].star; t != kNoIndex;) {
-      const Live& l = live[t];
-      if (sorted(l.corner) == key) return true;
-      const int k = l.corner[0] == rep[0] ? 0 : (l.corner[1] == rep[0] ? 1 : 2);
-      t = l.next[k];
-    }
-    return false;
+    bool found = false;
+    for_each_wedge(open[first], [&](const Wedge& w) {
+      found =
+          found || (w.next == rep[1] && w.prev == rep[2]) || (w.next == rep[2] && w.prev == rep[1]);
+    });
+    return found;
   }
 
   void add_triangle(const Triangle& numbers, std::uint32_t group) {
@@ -265,22 +293,7 @@ struct StreamStats::Impl {
       ++stats.duplicate_triangles;
       return;
     }
-    std::uint32_t t = 0;
-    if (free_live.empty()) {
-      t = static_cast<std::uint32_t>(live.size());
-      live.emplace_back();
-    } else {
-      t = free_live.back();
-      free_live.pop_back();
-    }
-    Live& l = live[t];
-    l.corner = rep;
-    l.group = group;
-    l.open_corners = 3;
-    for (int k = 0; k < 3; ++k) {
-      l.next[k] = open[o[k]].star;
-      open[o[k]].star = t;
-    }
+    for (int k = 0; k < 3; ++k) add_wedge(open[o[k]], {rep[(k + 1) % 3], rep[(k + 2) % 3], group});
     components.unite(open[o[0]].component, open[o[1]].component);
     components.unite(open[o[0]].component, open[o[2]].component);
   }
@@ -292,17 +305,14 @@ struct StreamStats::Impl {
     if (--open[o].refs == 0) judge(o);
   }
 
-  // v's star is complete: count its edges to vertices still open, its fans, then forget it.
+  // v's star is complete: count its fans and its edges, then forget it. Every edge is seen from
+  // both ends with the same triangles, so edge counts are taken at both ends and halved at the
+  // end; only a boundary edge looks up its other end, to join the two in the boundary graph
+  // while both are open.
   void judge(std::uint32_t o) {
-    const std::uint32_t v = open[o].rep;
+    Open& vertex = open[o];
     star.clear();
-    for (std::uint32_t t = open[o].star; t != kNoIndex;) {
-      star.push_back(t);
-      const Live& l = live[t];
-      t = l.next[l.corner[0] == v ? 0 : (l.corner[1] == v ? 1 : 2)];
-    }
-    // The list runs newest first; compute_stats walks a star in input order.
-    std::reverse(star.begin(), star.end());
+    for_each_wedge(vertex, [&](const Wedge& w) { star.push_back(w); });
     if (!star.empty()) ++stats.vertices;
     groups.clear();
     group_next.clear();
@@ -317,39 +327,35 @@ struct StreamStats::Impl {
       e.out += outgoing;
       return g;
     };
-    for (std::uint32_t t : star) {
-      const Triangle& c = live[t].corner;
-      const int p = c[0] == v ? 0 : (c[1] == v ? 1 : 2);
-      const auto i = static_cast<std::uint32_t>(group_next.size());
-      group_next.push_back(touch(c[(p + 1) % 3], i, 1));
-      group_prev.push_back(touch(c[(p + 2) % 3], i, 0));
+    for (std::uint32_t i = 0; i < star.size(); ++i) {
+      group_next.push_back(touch(star[i].next, i, 1));
+      group_prev.push_back(touch(star[i].prev, i, 0));
     }
     const std::size_t k = star.size();
     fan.resize(k);
     for (std::uint32_t i = 0; i < k; ++i) fan[i] = i;
     for (const EdgeGroup& e : groups) {
-      if (e.count == 2) {
+      if (e.count == 1) {
+        ++boundary_ends;
+        const std::uint32_t w = open_of.find(e.w);
+        if (w != IdMap::kMissing) {  // else joined when that end was judged
+          const std::uint64_t before = borders.merges;
+          borders.unite(vertex.border, open[w].border);
+          boundary_merges += borders.merges - before;
+        }
+      } else if (e.count == 2) {
         const std::uint32_t a = find_root(fan, e.first), b = find_root(fan, e.second);
         if (a != b) fan[std::max(a, b)] = std::min(a, b);
-      }
-      const std::uint32_t w = open_of.find(e.w);
-      if (w == IdMap::kMissing) continue;  // counted when that end was judged
-      if (e.count == 1) {
-        ++stats.boundary_edges;
-        const std::uint64_t before = borders.merges;
-        borders.unite(open[o].border, open[w].border);
-        boundary_merges += borders.merges - before;
-      } else if (e.count == 2) {
-        const std::uint32_t g1 = live[star[e.first]].group, g2 = live[star[e.second]].group;
+        const std::uint32_t g1 = star[e.first].group, g2 = star[e.second].group;
         const bool same_way = e.out != 1;
         if (g1 == g2) {
-          stats.orientation_conflicts += same_way ? 1 : 0;
+          conflict_ends += same_way ? 1 : 0;
         } else {
           const std::uint64_t pair = std::uint64_t{std::min(g1, g2)} << 32 | std::max(g1, g2);
           ++group_pairs[pair][same_way ? 0 : 1];
         }
       } else {
-        ++stats.non_manifold_edges;
+        ++non_manifold_ends;
       }
     }
     fan_open.assign(k, 0);
@@ -366,13 +372,13 @@ struct StreamStats::Impl {
         any_closed = any_closed || (fan[i] == i && !fan_open[i]);
       ++(any_closed ? stats.non_manifold_vertices_type1 : stats.non_manifold_vertices_type2);
     }
-    for (std::uint32_t t : star) {
-      if (--live[t].open_corners == 0) free_live.push_back(t);
+    if (vertex.overflow != kNoIndex) {
+      overflow[vertex.overflow].clear();
+      free_overflow.push_back(vertex.overflow);
     }
-    open_of.erase(v);
+    open_of.erase(vertex.rep);
     welder_erase(o);
-    open[o].star = kNoIndex;
-    open[o].refs = 0;
+    vertex.refs = 0;
     free_open.push_back(o);
     --open_count;
   }
@@ -387,16 +393,21 @@ struct StreamStats::Impl {
     for (const auto& [pair, ways] : group_pairs) {
       const auto g1 = static_cast<std::uint32_t>(pair >> 32), g2 = static_cast<std::uint32_t>(pair);
       const bool one_flipped = (g1 < flip.size() && flip[g1]) != (g2 < flip.size() && flip[g2]);
-      stats.orientation_conflicts += one_flipped ? ways[1] : ways[0];
+      conflict_ends += one_flipped ? ways[1] : ways[0];
     }
+    stats.boundary_edges = boundary_ends / 2;
+    stats.orientation_conflicts = conflict_ends / 2;
+    stats.non_manifold_edges = non_manifold_ends / 2;
     stats.holes = stats.boundary_edges - boundary_merges;
     stats.components = stats.vertices - components.merges;
   }
 
   std::uint64_t bytes() const {
-    return open.capacity() * sizeof(Open) + live.capacity() * sizeof(Live) +
-           (welder.capacity() + free_open.capacity() + free_live.capacity() +
-            components.parent.capacity() + borders.parent.capacity()) *
+    std::uint64_t overflowing = 0;
+    for (const std::vector<Wedge>& list : overflow) overflowing += list.capacity() * sizeof(Wedge);
+    return open.capacity() * sizeof(Open) + overflowing +
+           (welder.capacity() + free_open.capacity() + components.parent.capacity() +
+            borders.parent.capacity()) *
                sizeof(std::uint32_t) +
            open_of.size() * 16 + group_pairs.size() * 48;
   }
