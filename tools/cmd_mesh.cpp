@@ -96,6 +96,7 @@ void run_mesh(MeshArgs& args) {
   if (temporary || !reusable(store_path, args.input)) {
     TileStoreOptions tiling;
     tiling.tile_points = args.tile_points > 0 ? args.tile_points : plan.tile_points;
+    if (args.tile_points == 0) tiling.min_tiles = plan.min_tiles;
     tiling.round_points = std::max(plan.round_points, tiling.tile_points);
     tiling.compress = args.compress;
     tiling.progress = [&](std::uint64_t done, std::uint64_t total) {
@@ -187,9 +188,9 @@ void add_mesh_command(CLI::App& app) {
                   "tile size and the tiles in flight; the peak resident memory stays below it")
       ->transform(CLI::AsSizeValue(false));
   cmd->add_option("--tile-points", args->tile_points,
-                  "Largest number of points in a tile (default: from --memory, at most "
-                  "1048576): the cloud is cut into tiles grown in parallel and stitched at the "
-                  "seams")
+                  "Largest number of points in a tile (default: an eighth of the cloud, at "
+                  "least 16384, at most 1048576 and what --memory holds): the cloud is cut into "
+                  "tiles grown in parallel and stitched at the seams")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--keep-store", args->keep_store,
                   "Keep the tile store at this path (reused by the next run while it is newer "

@@ -146,6 +146,7 @@ PipelineMesh mesh_tiles(const TileSource& source, const PipelineOptions& options
 // margin docs/pipeline.md gives; a budget too small for a workable tile throws Error(usage).
 struct MemoryPlan {
   std::uint64_t tile_points = 0;
+  std::uint64_t min_tiles = 1;  // TileStoreOptions::min_tiles: at least this many tiles
   std::size_t tiles_in_flight = 0;
   std::uint64_t round_points = 0;
 };

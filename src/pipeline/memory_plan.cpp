@@ -23,9 +23,14 @@ constexpr double kWaitingBytesPerPoint = 100;  // a grown tile waiting to be sti
 constexpr double kStitchBytesPerPoint = 150;   // the tile being stitched and released
 constexpr double kFixedBytes = 40e6;           // code, TBB, buffers, the live band
 constexpr double kStoreBytesPerPoint = 64;     // the tile store writer, per point of a round
-// The default tile, when the budget allows it (docs/pipeline.md, "Tile size", measured it): small
-// enough that clouds from about 100k points up are cut into tiles that keep two cores busy.
-constexpr std::uint64_t kDefaultTile = std::uint64_t{1} << 17;
+// The largest default tile, when the budget allows it (docs/pipeline.md, "Tile size"): larger
+// tiles save no time, and on photogrammetry each seam costs a few tenths of a second of serial
+// stitching.
+constexpr std::uint64_t kDefaultTile = std::uint64_t{1} << 20;
+// Clouds are cut into at least this many tiles (of at least 16,384 points, TileStoreOptions),
+// so that clouds from about 100k points up grow on several threads; a count of the input, not
+// of the threads, so the mesh is the same for any --threads.
+constexpr std::uint64_t kMinTiles = 8;
 // Tiles growing at once that the tile size is planned for (more when the budget holds them).
 constexpr double kPlannedGrowers = 2;
 constexpr std::uint64_t kSmallestTile = 4096;
@@ -49,6 +54,7 @@ MemoryPlan plan_memory(std::uint64_t budget_bytes, int threads) {
   }
   MemoryPlan plan;
   plan.tile_points = std::min(kDefaultTile, static_cast<std::uint64_t>(tile));
+  plan.min_tiles = kMinTiles;
   const double tile_size = static_cast<double>(plan.tile_points);
   const double growers =
       (usable / tile_size - kWaitingBytesPerPoint - kStitchBytesPerPoint) / kGrowBytesPerPoint;
