@@ -188,7 +188,7 @@ void add_mesh_command(CLI::App& app) {
                   "tile size and the tiles in flight; the peak resident memory stays below it")
       ->transform(CLI::AsSizeValue(false));
   cmd->add_option("--tile-points", args->tile_points,
-                  "Largest number of points in a tile (default: an eighth of the cloud, at "
+                  "Largest number of points in a tile (default: a quarter of the cloud, at "
                   "least 16384, at most 1048576 and what --memory holds): the cloud is cut into "
                   "tiles grown in parallel and stitched at the seams")
       ->check(CLI::PositiveNumber);

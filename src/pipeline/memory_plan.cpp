@@ -30,7 +30,7 @@ constexpr std::uint64_t kDefaultTile = std::uint64_t{1} << 20;
 // Clouds are cut into at least this many tiles (of at least 16,384 points, TileStoreOptions),
 // so that clouds from about 100k points up grow on several threads; a count of the input, not
 // of the threads, so the mesh is the same for any --threads.
-constexpr std::uint64_t kMinTiles = 8;
+constexpr std::uint64_t kMinTiles = 4;
 // Tiles growing at once that the tile size is planned for (more when the budget holds them).
 constexpr double kPlannedGrowers = 2;
 constexpr std::uint64_t kSmallestTile = 4096;
