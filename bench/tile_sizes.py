@@ -7,7 +7,8 @@ threads over 1.
 
     bench/tile_sizes.py --g2s build/g2s --sizes 0 262144 131072 --threads 1 2 --runs 3 CLOUD...
 
-Size 0 is the default (no --tile-points). Python 3 standard library only.
+Size 0 is the default (no --tile-points); --stats keeps the defect summary. Each run records
+the per-stage wall and CPU seconds of `--json` ("stages"). Python 3 standard library only.
 """
 
 import argparse
@@ -19,12 +20,17 @@ import sys
 import tempfile
 
 
+STATS = False
+
+
 def load():
     return os.getloadavg()[0]
 
 
 def run(g2s, cloud, size, threads, out):
-    cmd = [g2s, "mesh", cloud, "-o", out, "--threads", str(threads), "--json", "--no-stats"]
+    cmd = [g2s, "mesh", cloud, "-o", out, "--threads", str(threads), "--json"]
+    if not STATS:
+        cmd.append("--no-stats")
     if size:
         cmd += ["--tile-points", str(size)]
     before = load()
@@ -34,6 +40,7 @@ def run(g2s, cloud, size, threads, out):
             "tiles": summary["tiles"], "triangles": summary["triangles"],
             "seconds": summary["seconds"], "seconds_stitch": summary["seconds_stitch"],
             "seconds_grow": summary["seconds_grow"], "peak_rss_mb": summary["peak_rss_mb"],
+            "cpu": summary.get("stages"),
             "load_before": round(before, 2), "load_after": round(load(), 2)}
 
 
@@ -43,8 +50,11 @@ def main():
     parser.add_argument("--sizes", type=int, nargs="+", default=[0])
     parser.add_argument("--threads", type=int, nargs="+", default=[1, 2])
     parser.add_argument("--runs", type=int, default=3)
+    parser.add_argument("--stats", action="store_true", help="with the defect summary")
     parser.add_argument("clouds", nargs="+")
     args = parser.parse_args()
+    global STATS
+    STATS = args.stats
     rows = []
     with tempfile.TemporaryDirectory() as folder:
         out = os.path.join(folder, "mesh.stl")
