@@ -88,7 +88,7 @@ void print_input_notes(const std::string& input, const ReadReport& report) {
 
 void run_mesh(MeshArgs& args) {
   Progress progress(!args.out.quiet && !args.out.json);
-  RunFacts run{args.input, 0, 0, std::chrono::steady_clock::now(), {}, {}};
+  RunFacts run{args.input, 0, 0, std::chrono::steady_clock::now(), {}, {}, {}};
   refuse_same_file({args.input}, args.out.output, "-o");
   checked_mesh_format(args.out.output, args.out.ascii);
   check_radius_steps(args.options.mesh.radius_steps);
@@ -116,13 +116,18 @@ void run_mesh(MeshArgs& args) {
     if (temporary || !reusable(store_path, args.input, tile_points, args.out.quiet)) {
       TileStoreOptions tiling;
       tiling.tile_points = tile_points;
+      if (args.tile_points == 0) tiling.min_tiles = plan.min_tiles;
       tiling.round_points = std::max(plan.round_points, tiling.tile_points);
       tiling.compress = args.compress;
       tiling.progress = [&](std::uint64_t done, std::uint64_t total) {
         progress.stage("tiling",
                        total ? static_cast<double>(done) / static_cast<double>(total) : 1);
       };
+      const auto start = std::chrono::steady_clock::now();
+      const double cpu = cpu_seconds();
       read = build_tile_store(args.input, store_path, tiling).read;
+      run.tile = {std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+                  cpu_seconds() - cpu};
     }
     const TileStore store(store_path);
     if (read.format.empty()) read = store.input_report();
@@ -223,9 +228,9 @@ void add_mesh_command(CLI::App& app) {
                   "tile size and the tiles in flight; the peak resident memory stays below it")
       ->transform(byte_size());
   cmd->add_option("--tile-points", args->tile_points,
-                  "Largest number of points in a tile (default: from --memory, at most "
-                  "1048576; at least 500): the cloud is cut into tiles grown in parallel and "
-                  "stitched at the seams")
+                  "Largest number of points in a tile (default: a quarter of the cloud, at "
+                  "least 16384, at most 1048576 and what --memory holds; at least 500): the "
+                  "cloud is cut into tiles grown in parallel and stitched at the seams")
       ->check(count_range(kFewestTilePoints, 0xFFFFFFFF));
   cmd->add_option("--keep-store", args->keep_store,
                   "Keep the tile store at this path instead of a temporary beside the output; "

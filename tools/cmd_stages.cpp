@@ -125,7 +125,7 @@ void run_grow(GrowArgs& args) {
 
 void run_stitch(StitchArgs& args) {
   Progress progress(!args.out.quiet && !args.out.json);
-  RunFacts facts{args.store, 0, 0, std::chrono::steady_clock::now(), {}, {}};
+  RunFacts facts{args.store, 0, 0, std::chrono::steady_clock::now(), {}, {}, {}};
   check_radius_steps(args.options.mesh.radius_steps);
   refuse_same_file({args.store}, args.out.output, "-o");
   const TileStore store(args.store);

@@ -1,6 +1,8 @@
 // The end of `g2s mesh` and `g2s stitch`: the mesh is streamed to the output as the stitcher
-// finishes it, then read back and measured (g2s stats' counts) for the summary, so every run
-// reports its own defects (unless that read-back would not fit in --memory).
+// finishes it, and its defects (g2s stats' counts on the written file) are counted on the way
+// (StreamStats), so every run reports its own defects at little cost in time or memory. Only
+// when that count could not be exact is the written mesh read back instead, if that fits in
+// --memory.
 #include "mesh_output.hpp"
 
 #include <fmt/core.h>
@@ -16,6 +18,7 @@
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
 #include "g2s/stats.hpp"
+#include "g2s/stream_stats.hpp"
 #include "g2s/surface_check.hpp"
 #include "json_writer.hpp"
 #include "progress.hpp"
@@ -27,6 +30,34 @@ namespace {
 // stats' edge map): `g2s stats` on the 20M-triangle torus STL peaked at 1.70 GB (85 bytes a
 // triangle); twice that leaves room for meshes with more vertices per triangle.
 constexpr std::uint64_t kStatsBytesPerTriangle = 160;
+
+// Passes everything on and times the sink's finish (the output's last pass: flipped groups
+// rewritten, the file renamed into place).
+class TimedFinish final : public MeshSink {
+ public:
+  explicit TimedFinish(MeshSink& next) : next_(next) {}
+  void vertex(Index id, const double xyz[3]) override { next_.vertex(id, xyz); }
+  void triangle(const Triangle& corners, const std::array<const double*, 3>& xyz,
+                std::uint32_t group) override {
+    next_.triangle(corners, xyz, group);
+  }
+  void vertex_done(std::uint32_t vertex) override { next_.vertex_done(vertex); }
+  void finish(std::span<const std::uint8_t> flip) override {
+    const auto start = std::chrono::steady_clock::now();
+    const double cpu = cpu_seconds();
+    next_.finish(flip);
+    time.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    time.cpu = cpu_seconds() - cpu;
+  }
+  StageTime time;
+
+ private:
+  MeshSink& next_;
+};
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
 
 // STL holds 32-bit floats, whose step near 1e7 (georeferenced scans) is a metre: warn when that
 // rounding moves vertices by more than a hundredth of the sampling spacing.
@@ -159,22 +190,42 @@ void write_and_report(const TileSource& source,
   if (const std::string why = why_no_surface(source); !why.empty()) throw_no_surface(why, facts);
   install_output_signal_handler(args.output, facts.temporary_store);
   MeshStreamWriter writer(args.output, format);
-  const PipelineSummary summary = run(writer);
+  TimedFinish timed(writer);
+  // STL stores float coordinates: the count welds and judges them as read back.
+  StreamStats counter(timed, format != MeshFormat::ply_binary);
+  const auto mesh_start = std::chrono::steady_clock::now();
+  const double mesh_cpu = cpu_seconds();
+  const PipelineSummary summary = args.no_stats ? run(timed) : run(static_cast<MeshSink&>(counter));
+  const StageTime mesh{seconds_since(mesh_start), cpu_seconds() - mesh_cpu};
   if (summary.triangles == 0) throw_no_triangle(source, summary, facts);
   if (facts.output_written) facts.output_written();
   if (!args.quiet && format != MeshFormat::ply_binary) {
     warn_if_stl_rounds(args.output, writer, summary.report.spacing);
   }
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - facts.start).count();
   const MeshReport& r = summary.report;
   const std::uint64_t triangles = summary.triangles;
+  // The summary: counted in stride, or (should that count not be exact) read back when that
+  // fits in the budget.
+  const auto summary_start = std::chrono::steady_clock::now();
+  const double summary_cpu = cpu_seconds();
+  MeshStats stats;
+  bool measure = false;
+  // Far from the origin, STL's floats may merge vertices the stream saw apart (the warning
+  // above): the file is then measured as read back.
+  const bool stream_exact = counter.complete() && (format == MeshFormat::ply_binary ||
+                                                   writer.float_rounding() <= 0.01 * r.spacing);
+  if (!args.no_stats && stream_exact) {
+    stats = counter.stats();
+    measure = true;
+  } else if (!args.no_stats &&
+             (args.memory == 0 || triangles * kStatsBytesPerTriangle <= args.memory)) {
+    stats = compute_stats(read_mesh(args.output));
+    measure = true;
+  }
+  const StageTime measured{seconds_since(summary_start), cpu_seconds() - summary_cpu};
+  const double seconds = seconds_since(facts.start);
   const double ktps = static_cast<double>(triangles) / seconds / 1000.0;
   const double peak_mb = peak_rss_mb();
-  const bool measure =
-      !args.no_stats && (args.memory == 0 || triangles * kStatsBytesPerTriangle <= args.memory);
-  MeshStats stats;
-  if (measure) stats = compute_stats(read_mesh(args.output));
   if (args.json) {
     JsonObject json;
     json.text("input", facts.input)
@@ -200,6 +251,23 @@ void write_and_report(const TileSource& source,
         .fixed("seconds_cleanup", r.seconds_cleanup, 3)
         .fixed("ktriangles_per_second", ktps, 1)
         .fixed("peak_rss_mb", peak_mb, 1);
+    const auto stage = [](const StageTime& t) {
+      return JsonObject().fixed("wall", t.wall, 3).fixed("cpu", t.cpu, 3).str();
+    };
+    json.raw(
+        "stages",
+        JsonObject()
+            .raw("tile", stage(facts.tile))
+            .raw("grow_and_stitch", stage({mesh.wall - timed.time.wall, mesh.cpu - timed.time.cpu}))
+            .raw("grow", JsonObject().fixed("cpu", summary.cpu_seconds_grow, 3).str())
+            .raw("stitch", JsonObject().fixed("cpu", summary.cpu_seconds_stitch, 3).str())
+            .raw("output", stage(timed.time))
+            .raw("summary", JsonObject()
+                                .fixed("wall", measured.wall, 3)
+                                .fixed("cpu", measured.cpu, 3)
+                                .number("in_stride", measure && stream_exact)
+                                .str())
+            .str());
     if (measure) json.raw("stats", stats_to_json(stats));
     fmt::print("{}\n", json.str());
     return;
@@ -212,9 +280,13 @@ void write_and_report(const TileSource& source,
   if (measure) {
     fmt::print(stderr,
                "; non-manifold edges {}, non-manifold vertices {}, orientation conflicts {}, "
-               "boundary edges {}, holes {}, crossing triangle pairs {}",
+               "boundary edges {}, holes {}, duplicate triangles {}, degenerate triangles {}, "
+               "components {}, crossing triangle pairs {}",
                stats.non_manifold_edges, stats.non_manifold_vertices, stats.orientation_conflicts,
-               stats.boundary_edges, stats.holes, stats.crossing_pairs);
+               stats.boundary_edges, stats.holes, stats.duplicate_triangles,
+               stats.degenerate_triangles, stats.components,
+               stream_exact ? std::string("not counted here (g2s stats counts them)")
+                            : std::to_string(stats.crossing_pairs));
   } else if (!args.no_stats) {
     fmt::print(stderr,
                "; defects not measured: reading the mesh back would exceed --memory "

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "g2s/pipeline.hpp"
+#include "progress.hpp"
 
 namespace g2s::cli {
 
@@ -17,7 +18,8 @@ struct OutputArgs {
   bool quiet = false;
   bool json = false;
   bool no_stats = false;
-  // Bytes measuring the written mesh may take (it is read back whole); 0: no limit.
+  // Bytes reading the written mesh back may take, when its defects could not be counted as it
+  // streamed out (it is read back whole); 0: no limit.
   std::uint64_t memory = 0;
 };
 
@@ -32,6 +34,7 @@ struct RunFacts {
   std::function<void()> output_written;
   // The temporary tile store, removed by an interrupt after the mesh is complete; may be empty.
   std::string temporary_store;
+  StageTime tile;  // cutting the cloud into the tile store (zero when a kept store was reused)
 };
 
 // Runs the pipeline (`run` feeds the sink it is given) into args.output, written atomically,

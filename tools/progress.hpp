@@ -17,6 +17,20 @@ inline double peak_rss_mb() {
   return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
 }
 
+// CPU seconds the process has used so far, user and system, over all its threads.
+inline double cpu_seconds() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+}
+
+// A stage's wall and CPU seconds (the CPU of all threads).
+struct StageTime {
+  double wall = 0.0;
+  double cpu = 0.0;
+};
+
 // A one-line progress bar on stderr, redrawn in place; only when stderr is a terminal.
 class Progress {
  public:

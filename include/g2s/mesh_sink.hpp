@@ -21,6 +21,10 @@ class MeshSink {
   // group stores it.
   virtual void triangle(const Triangle& corners, const std::array<const double*, 3>& xyz,
                         std::uint32_t group) = 0;
+  // Vertex `vertex` (a number given by vertex()) is in no triangle still to come: its star is
+  // complete. A sink that counts defects in stride (StreamStats) finishes its edges then; others
+  // ignore it. Vertices not announced here are complete at finish().
+  virtual void vertex_done(std::uint32_t vertex) { (void)vertex; }
   // Every triangle has been given: those of group g are to be reversed where flip[g] != 0.
   virtual void finish(std::span<const std::uint8_t> flip) = 0;
 };

@@ -91,6 +91,10 @@ struct PipelineSummary {
   // The most points the stitcher held at once: the band of unfinished seams, not the cloud.
   std::uint64_t peak_live_points = 0;
   double seconds_stitch = 0.0;
+  // CPU seconds (thread clocks) of mesh_tiles' stages: growing, summed over the tiles, and the
+  // stitcher's intake of the tiles (seams, clean-up, and the sink's work as triangles go out).
+  double cpu_seconds_grow = 0.0;
+  double cpu_seconds_stitch = 0.0;
 };
 
 // The whole mesh in memory (tests, small clouds): triangles in global ids, oriented, manifold.
@@ -148,6 +152,7 @@ PipelineMesh mesh_tiles(const TileSource& source, const PipelineOptions& options
 // margin docs/pipeline.md gives; a budget too small for a workable tile throws Error(usage).
 struct MemoryPlan {
   std::uint64_t tile_points = 0;
+  std::uint64_t min_tiles = 1;  // TileStoreOptions::min_tiles: at least this many tiles
   std::size_t tiles_in_flight = 0;
   std::uint64_t round_points = 0;
 };

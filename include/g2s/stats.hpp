@@ -28,6 +28,9 @@ struct MeshStats {
   std::uint64_t crossing_pairs = 0;
   std::uint64_t crossing_pairs_no_shared_vertex = 0;  // of those, pairs with no vertex in common
   std::uint64_t crossing_triangles = 0;               // triangles in at least one crossing pair
+  // False where the crossings were not counted (g2s mesh's summary, counted as the mesh streams
+  // out): the three counts above are then left out of the text and JSON forms.
+  bool has_crossings = true;
   // With input points: share of them whose coordinates, rounded to float, are a vertex.
   bool has_coverage = false;
   std::uint64_t input_points = 0;

@@ -35,6 +35,11 @@ struct TileStoreOptions {
   // No tile holds more (adaptive split); the one exception is a tile of more than tile_points
   // copies of a single point, which no plane can separate.
   std::uint64_t tile_points = std::uint64_t{1} << 20;
+  // At least this many tiles, so that several threads have tiles to grow: once the cloud's
+  // point count is known, the largest tile is lowered to count / min_tiles, but never below
+  // min_tile_points (smaller clouds are fewer tiles). 1: tile_points alone decides.
+  std::uint64_t min_tiles = 1;
+  std::uint64_t min_tile_points = 16384;
   bool compress = false;  // zstd-compress the point blocks
   int zstd_level = 1;
   // Points the writer holds in memory at once (28 bytes each; at least tile_points): the bound

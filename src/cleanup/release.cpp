@@ -94,7 +94,10 @@ void release_finished(LiveMesh& live, std::size_t step, const Vec3& origin, Mesh
   live.group.resize(kept);
   live.due.resize(kept);
   for (std::uint32_t s : maybe_free) {
-    if ((live.flags[s] & LiveMesh::kReleased) && live.uses[s] == 0) live.free_slot(s);
+    if ((live.flags[s] & LiveMesh::kReleased) && live.uses[s] == 0) {
+      if (live.number[s] != kNoIndex) sink.vertex_done(live.number[s]);
+      live.free_slot(s);
+    }
   }
 }
 

@@ -23,7 +23,16 @@ constexpr double kWaitingBytesPerPoint = 100;  // a grown tile waiting to be sti
 constexpr double kStitchBytesPerPoint = 150;   // the tile being stitched and released
 constexpr double kFixedBytes = 40e6;           // code, TBB, buffers, the live band
 constexpr double kStoreBytesPerPoint = 64;     // the tile store writer, per point of a round
-constexpr std::uint64_t kLargestTile = std::uint64_t{1} << 20;
+// The largest default tile, when the budget allows it (docs/pipeline.md, "Tile size"): larger
+// tiles save no time, and on photogrammetry each seam costs a few tenths of a second of serial
+// stitching.
+constexpr std::uint64_t kDefaultTile = std::uint64_t{1} << 20;
+// Clouds are cut into at least this many tiles (of at least 16,384 points, TileStoreOptions),
+// so that clouds from about 100k points up grow on several threads; a count of the input, not
+// of the threads, so the mesh is the same for any --threads.
+constexpr std::uint64_t kMinTiles = 4;
+// Tiles growing at once that the tile size is planned for (more when the budget holds them).
+constexpr double kPlannedGrowers = 2;
 constexpr std::uint64_t kSmallestTile = 4096;
 
 }  // namespace
@@ -31,19 +40,25 @@ constexpr std::uint64_t kSmallestTile = 4096;
 MemoryPlan plan_memory(std::uint64_t budget_bytes, int threads) {
   const auto workers = static_cast<std::size_t>(
       threads > 0 ? threads : std::max(1, tbb::info::default_concurrency()));
-  MemoryPlan plan;
-  plan.tiles_in_flight = workers + 1;
+  // The tile size is sized for kPlannedGrowers tiles growing at once whatever --threads says, so
+  // that the tiles, and with them the mesh, are the same for any thread count; the threads then
+  // get as many tiles in flight as the budget holds at that size.
   const double usable = static_cast<double>(budget_bytes) - kFixedBytes;
-  const double per_tile_point = static_cast<double>(workers) * kGrowBytesPerPoint +
-                                kWaitingBytesPerPoint + kStitchBytesPerPoint;
-  const double tile = usable / per_tile_point;
+  const double planned_per_point =
+      kPlannedGrowers * kGrowBytesPerPoint + kWaitingBytesPerPoint + kStitchBytesPerPoint;
+  const double tile = usable / planned_per_point;
   if (!(tile >= static_cast<double>(kSmallestTile))) {
     throw Error(Exit::usage,
-                fmt::format("--memory {} MB is too small for {} threads: at least {:.0f} MB",
-                            budget_bytes >> 20, workers,
-                            (kFixedBytes + per_tile_point * kSmallestTile) / 1048576.0 + 1));
+                fmt::format("--memory {} MB is too small: at least {:.0f} MB", budget_bytes >> 20,
+                            (kFixedBytes + planned_per_point * kSmallestTile) / 1048576.0 + 1));
   }
-  plan.tile_points = std::min(kLargestTile, static_cast<std::uint64_t>(tile));
+  MemoryPlan plan;
+  plan.tile_points = std::min(kDefaultTile, static_cast<std::uint64_t>(tile));
+  plan.min_tiles = kMinTiles;
+  const double tile_size = static_cast<double>(plan.tile_points);
+  const double growers =
+      (usable / tile_size - kWaitingBytesPerPoint - kStitchBytesPerPoint) / kGrowBytesPerPoint;
+  plan.tiles_in_flight = std::min(workers, static_cast<std::size_t>(growers)) + 1;
   plan.round_points = std::clamp(static_cast<std::uint64_t>(usable / kStoreBytesPerPoint),
                                  plan.tile_points, std::uint64_t{8} << 20);
   return plan;

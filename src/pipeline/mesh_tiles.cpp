@@ -3,7 +3,9 @@
 #include <tbb/global_control.h>
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
+#include <time.h>
 
+#include <atomic>
 #include <memory>
 
 #include "g2s/pipeline.hpp"
@@ -36,6 +38,13 @@ class MemorySink final : public MeshSink {
   std::vector<std::uint32_t> group_;
 };
 
+// CPU nanoseconds the calling thread has used.
+std::uint64_t thread_cpu_ns() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<std::uint64_t>(t.tv_sec) * 1000000000u + static_cast<std::uint64_t>(t.tv_nsec);
+}
+
 }  // namespace
 
 PipelineSummary mesh_tiles(const TileSource& source, const PipelineOptions& options,
@@ -53,6 +62,8 @@ PipelineSummary mesh_tiles(const TileSource& source, const PipelineOptions& opti
                           : static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
   Stitcher stitcher(source, options, sink);
   std::size_t next = 0;
+  std::atomic<std::uint64_t> grow_ns{0};
+  std::uint64_t stitch_ns = 0;
   tbb::parallel_pipeline(
       options.tiles_in_flight > 0 ? options.tiles_in_flight : 2 * workers,
       tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
@@ -63,14 +74,22 @@ PipelineSummary mesh_tiles(const TileSource& source, const PipelineOptions& opti
           tbb::make_filter<std::size_t, std::pair<std::size_t, TileGrowth>>(
               tbb::filter_mode::parallel,
               [&](std::size_t t) {
-                return std::pair{t, grow_tile(source, t, options)};
+                const std::uint64_t start = thread_cpu_ns();
+                std::pair grown{t, grow_tile(source, t, options)};
+                grow_ns += thread_cpu_ns() - start;
+                return grown;
               }) &
           tbb::make_filter<std::pair<std::size_t, TileGrowth>, void>(
               tbb::filter_mode::serial_in_order, [&](std::pair<std::size_t, TileGrowth> grown) {
+                const std::uint64_t start = thread_cpu_ns();
                 stitcher.add(grown.first, std::move(grown.second));
+                stitch_ns += thread_cpu_ns() - start;
                 if (options.progress) options.progress(grown.first + 1, tiles);
               }));
-  return stitcher.finish();
+  PipelineSummary summary = stitcher.finish();
+  summary.cpu_seconds_grow = 1e-9 * static_cast<double>(grow_ns.load());
+  summary.cpu_seconds_stitch = 1e-9 * static_cast<double>(stitch_ns);
+  return summary;
 }
 
 PipelineMesh mesh_tiles(const TileSource& source, const PipelineOptions& options) {

@@ -33,10 +33,13 @@ std::vector<Field> fields(const MeshStats& s) {
       {"holes", "holes", s.holes},
       {"orientation_conflicts", "orientation conflicts", s.orientation_conflicts},
       {"components", "components", s.components},
-      {"crossing_pairs", "crossing triangle pairs", s.crossing_pairs},
-      {"crossing_pairs_no_shared_vertex", "  sharing no vertex", s.crossing_pairs_no_shared_vertex},
-      {"crossing_triangles", "crossing triangles", s.crossing_triangles},
   };
+  if (s.has_crossings) {
+    out.push_back({"crossing_pairs", "crossing triangle pairs", s.crossing_pairs});
+    out.push_back({"crossing_pairs_no_shared_vertex", "  sharing no vertex",
+                   s.crossing_pairs_no_shared_vertex});
+    out.push_back({"crossing_triangles", "crossing triangles", s.crossing_triangles});
+  }
   if (s.has_coverage) {
     out.push_back({"input_points", "input points", s.input_points});
     out.push_back({"covered_points", "covered points", s.covered_points});

@@ -366,19 +366,6 @@ void Stitcher::add(std::size_t tile, TileGrowth growth) {
       for (Index v : growth.triangles[k]) held[check(v)] = 1;
     }
     for (Index v : growth.second_fans) held[check(v)] = 1;
-    // Final triangles go to the output now; a corner's vertex number moves into its slot if it
-    // gets one.
-    std::vector<std::uint32_t> number(points.size(), kNoIndex);
-    for (std::size_t k = 0; k < growth.final_triangles; ++k) {
-      const Triangle& t = growth.triangles[k];
-      const std::uint32_t group = base + growth.group[k];
-      emit_triangle({&number[check(t[0])], &number[check(t[1])], &number[check(t[2])]},
-                    {&points.xyz[3 * std::size_t{t[0]}], &points.xyz[3 * std::size_t{t[1]}],
-                     &points.xyz[3 * std::size_t{t[2]}]},
-                    {points.ids[t[0]], points.ids[t[1]], points.ids[t[2]]}, live.sums[group], group,
-                    m.origin, m.sink, m.released);
-    }
-    slot_of_point.assign(points.size(), kNoIndex);
     std::vector<std::size_t> later;
     double inside = 0;
     for (std::size_t j = tile + 1; j < tiles.size(); ++j) {
@@ -391,17 +378,48 @@ void Stitcher::add(std::size_t tile, TileGrowth growth) {
     // Deeper than this, a point is out of reach of this tile's seams, even as the far corner of a
     // live triangle touching the band (the longest edge: the margin).
     const double unreachable = m.reach[tile].touch + m.reach[tile].margin;
+    // Each point's release step, and whether a seam can look it up, known before the final
+    // triangles go out: a point only they use is announced done to the sink right after its
+    // last one (a sink counting defects in stride then holds few points open).
+    std::vector<std::uint32_t> release(points.size());
+    std::vector<std::uint8_t> listed(points.size());
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      const double* p = &points.xyz[3 * k];
+      release[k] = m.last_step(tile, p, later, inside, true);
+      listed[k] = release[k] != tile || box_depth(tiles[tile].box, p) <= unreachable;
+    }
+    std::vector<std::size_t> last_final(points.size(), growth.final_triangles);
+    for (std::size_t k = 0; k < growth.final_triangles; ++k) {
+      for (Index v : growth.triangles[k]) last_final[check(v)] = k;
+    }
+    // Final triangles go to the output now; a corner's vertex number moves into its slot if it
+    // gets one.
+    std::vector<std::uint32_t> number(points.size(), kNoIndex);
+    for (std::size_t k = 0; k < growth.final_triangles; ++k) {
+      const Triangle& t = growth.triangles[k];
+      const std::uint32_t group = base + growth.group[k];
+      emit_triangle({&number[t[0]], &number[t[1]], &number[t[2]]},
+                    {&points.xyz[3 * std::size_t{t[0]}], &points.xyz[3 * std::size_t{t[1]}],
+                     &points.xyz[3 * std::size_t{t[2]}]},
+                    {points.ids[t[0]], points.ids[t[1]], points.ids[t[2]]}, live.sums[group], group,
+                    m.origin, m.sink, m.released);
+      for (Index v : t) {
+        if (last_final[v] == k && !listed[v] && !held[v]) {
+          m.sink.vertex_done(number[v]);
+          last_final[v] = growth.final_triangles;
+        }
+      }
+    }
+    slot_of_point.assign(points.size(), kNoIndex);
     for (std::size_t k = 0; k < points.size(); ++k) {
       if (points.ids[k] >= m.source.point_count()) {
         throw Error(Exit::bad_input, "tile store: a point id is out of range");
       }
       const double* p = &points.xyz[3 * k];
-      const std::uint32_t release = m.last_step(tile, p, later, inside, true);
-      const bool listed = release != tile || box_depth(tiles[tile].box, p) <= unreachable;
-      if (!listed && !held[k]) continue;  // only in final triangles, or in none
+      if (!listed[k] && !held[k]) continue;  // only in final triangles, or in none
       const std::uint32_t finish =
-          release == tile ? release : m.last_step(tile, p, later, inside, false);
-      slot_of_point[k] = live.add_point(points.ids[k], p, finish, release, listed);
+          release[k] == tile ? release[k] : m.last_step(tile, p, later, inside, false);
+      slot_of_point[k] = live.add_point(points.ids[k], p, finish, release[k], listed[k] != 0);
       live.number[slot_of_point[k]] = number[k];
     }
   }

@@ -300,11 +300,16 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
   const std::uint64_t total = first.points;
   if (options.progress) options.progress(0, total);
 
+  std::uint64_t tile_points = options.tile_points;
+  if (options.min_tiles > 1) {
+    const std::uint64_t share = (total + options.min_tiles - 1) / options.min_tiles;
+    tile_points = std::min(tile_points, std::max(share, options.min_tile_points));
+  }
   TileTree tree(bounds);
   std::vector<std::uint64_t> counts;
   std::vector<std::uint32_t> leaves;
   if (total > 0) {
-    counts = split_into_tiles(input, tree, sample, first, options.tile_points);
+    counts = split_into_tiles(input, tree, sample, first, tile_points);
     leaves = tree.leaves();
   }
   sample = PointSample(0);  // its memory is not needed while writing

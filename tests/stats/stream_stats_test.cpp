@@ -1,0 +1,208 @@
+// StreamStats, the defects counted while a mesh streams out, against compute_stats on the same
+// mesh as the file holds it (orientation groups flipped at the end): a hand-made mesh with every
+// kind of defect, random soups with welded positions, duplicates and degenerate triangles, and
+// vertices announced done as early as possible or only at the end. Then `g2s mesh` itself: its
+// summary against `g2s stats` on the file it wrote, STL and PLY, cut into many tiles.
+#include "g2s/stream_stats.hpp"
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "g2s/stats.hpp"
+#include "support/temp_folder.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using g2s::IndexedMesh;
+using g2s::MeshStats;
+using g2s::Triangle;
+
+class NullSink final : public g2s::MeshSink {
+ public:
+  void vertex(g2s::Index, const double[3]) override {}
+  void triangle(const Triangle&, const std::array<const double*, 3>&, std::uint32_t) override {}
+  void finish(std::span<const std::uint8_t>) override {}
+};
+
+// Streams `mesh` (triangles in `group`) through StreamStats as the pipeline does: each vertex
+// numbered before its first triangle, announced done after its last one when `early` (else
+// left to finish()), and the groups in `flip` reversed at the end.
+MeshStats streamed(const IndexedMesh& mesh, const std::vector<std::uint32_t>& group,
+                   const std::vector<std::uint8_t>& flip, bool early, bool* complete) {
+  NullSink null;
+  g2s::StreamStats counter(null, false);
+  // A vertex is done after the last triangle at its position: the pipeline gives every vertex
+  // welded to another its number while that one is still open.
+  std::map<std::array<double, 3>, std::size_t> last_at;
+  auto position = [&](g2s::Index v) {
+    return std::array<double, 3>{mesh.xyz[3 * v], mesh.xyz[3 * v + 1], mesh.xyz[3 * v + 2]};
+  };
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    for (g2s::Index v : mesh.triangles[t]) last_at[position(v)] = t;
+  }
+  std::vector<std::vector<g2s::Index>> done_after(mesh.triangles.size());
+  std::vector<std::uint8_t> used(mesh.vertex_count(), 0);
+  for (const Triangle& t : mesh.triangles) {
+    for (g2s::Index v : t) {
+      if (!used[v]) done_after[last_at[position(v)]].push_back(v);
+      used[v] = 1;
+    }
+  }
+  std::vector<std::uint32_t> number(mesh.vertex_count(), g2s::kNoIndex);
+  std::uint32_t next = 0;
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    Triangle numbers{};
+    std::array<const double*, 3> xyz{};
+    for (int k = 0; k < 3; ++k) {
+      const g2s::Index v = mesh.triangles[t][k];
+      xyz[k] = &mesh.xyz[3 * std::size_t{v}];
+      if (number[v] == g2s::kNoIndex) {
+        number[v] = next++;
+        counter.vertex(v, xyz[k]);
+      }
+      numbers[k] = number[v];
+    }
+    counter.triangle(numbers, xyz, group[t]);
+    if (!early) continue;
+    for (g2s::Index v : done_after[t]) counter.vertex_done(number[v]);
+  }
+  counter.finish(flip);
+  *complete = counter.complete();
+  return counter.stats();
+}
+
+// The mesh as the file holds it: each triangle of a flipped group reversed.
+IndexedMesh as_written(IndexedMesh mesh, const std::vector<std::uint32_t>& group,
+                       const std::vector<std::uint8_t>& flip) {
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    if (flip[group[t]]) std::swap(mesh.triangles[t][1], mesh.triangles[t][2]);
+  }
+  return mesh;
+}
+
+void expect_same(const MeshStats& a, const MeshStats& b, const std::string& what) {
+  EXPECT_EQ(g2s::stats_to_json(a), g2s::stats_to_json(b)) << what;
+}
+
+TEST(StreamStats, EveryDefectKindAsComputeStatsCountsIt) {
+  // A tetrahedron (groups 0 and 1, face 3 in group 1 wound the other way, so flipping group 1
+  // fixes it), a fin on edge 0-1 (a third triangle: non-manifold edge), a reversed copy of face
+  // 0, a collinear triangle, an open strip, and vertex 8 at vertex 0's position (welded).
+  IndexedMesh mesh;
+  mesh.xyz = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0.5, -1, 0.5, 2, 0,
+              0, 5, 5, 5, 6, 5, 5, 0, 0, 0, 5, 6, 5,   3,  0,   0};
+  mesh.triangles = {{0, 2, 1}, {0, 1, 3},  {1, 2, 3}, {0, 2, 3}, {0, 1, 4},
+                    {0, 1, 2}, {1, 5, 10}, {6, 7, 9}, {8, 3, 2}, {7, 6, 9}};
+  const std::vector<std::uint32_t> group = {0, 0, 0, 1, 2, 0, 0, 3, 1, 3};
+  for (const std::vector<std::uint8_t>& flip :
+       {std::vector<std::uint8_t>{0, 0, 0, 0}, std::vector<std::uint8_t>{0, 1, 0, 1}}) {
+    const MeshStats expected = g2s::compute_stats(as_written(mesh, group, flip));
+    ASSERT_GT(expected.non_manifold_edges, 0u);
+    ASSERT_GT(expected.duplicate_triangles, 0u);
+    ASSERT_GT(expected.degenerate_triangles, 0u);
+    for (bool early : {false, true}) {
+      bool complete = false;
+      expect_same(streamed(mesh, group, flip, early, &complete), expected,
+                  early ? "done early" : "done at the end");
+      EXPECT_TRUE(complete);
+    }
+  }
+}
+
+TEST(StreamStats, RandomSoupsWithWeldedPositions) {
+  std::mt19937 random(7);
+  auto draw = [&](std::uint32_t below) { return static_cast<std::uint32_t>(random() % below); };
+  for (int round = 0; round < 300; ++round) {
+    const std::uint32_t points = 6 + draw(20);
+    IndexedMesh mesh;
+    for (std::uint32_t v = 0; v < points; ++v) {
+      // Few distinct positions on a small grid, so that welding, collinear corners and
+      // repeated vertex sets all occur.
+      for (int k = 0; k < 3; ++k) mesh.xyz.push_back(static_cast<double>(draw(3)));
+    }
+    const std::size_t count = 1 + draw(40);
+    std::vector<std::uint32_t> group;
+    const std::uint32_t groups = 1 + draw(4);
+    for (std::size_t t = 0; t < count; ++t) {
+      mesh.triangles.push_back({draw(points), draw(points), draw(points)});
+      group.push_back(draw(groups));
+    }
+    std::vector<std::uint8_t> flip(groups);
+    for (auto& f : flip) f = static_cast<std::uint8_t>(draw(2));
+    const MeshStats expected = g2s::compute_stats(as_written(mesh, group, flip));
+    for (bool early : {false, true}) {
+      bool complete = false;
+      expect_same(streamed(mesh, group, flip, early, &complete), expected,
+                  "round " + std::to_string(round) + (early ? ", done early" : ""));
+      EXPECT_TRUE(complete);
+    }
+  }
+}
+
+// `g2s mesh`'s own summary against `g2s stats` on the written file.
+class MeshSummary : public ::testing::Test {
+ protected:
+  std::string run(const std::string& args) const {
+    const fs::path out = dir_ / "stdout.txt";
+    const std::string command = "\"" + std::string(G2S_CLI_PATH) + "\" " + args + " > \"" +
+                                out.string() + "\" 2> /dev/null";
+    const int status = std::system(command.c_str());
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << command;
+    return g2s::test_support::file_bytes(out);
+  }
+  // The number after "key": (-1 when missing).
+  static double number(const std::string& json, const std::string& key) {
+    const std::string quoted = "\"" + key + "\":";
+    const std::size_t at = json.find(quoted);
+    return at == std::string::npos ? -1 : std::strtod(json.c_str() + at + quoted.size(), nullptr);
+  }
+  // The object after "stats": in g2s mesh --json.
+  static std::string stats_object(const std::string& json) {
+    const std::size_t at = json.find("\"stats\":");
+    if (at == std::string::npos) return "";
+    const std::size_t begin = json.find('{', at);
+    return json.substr(begin, json.find('}', begin) - begin + 1);
+  }
+  g2s::test_support::TempFolder folder_{"g2s-summary"};
+  const fs::path dir_ = folder_.path();
+};
+
+TEST_F(MeshSummary, CountedInStrideAsGStatsCountsTheFile) {
+  const char* env = std::getenv("G2S_DATA_DIR");
+  const fs::path data = env && *env ? fs::path(env) : fs::path(G2S_DEFAULT_DATA_DIR);
+  int checked = 0;
+  for (const char* scan : {"open-bunny-scan-bun000", "open-autzen-lidar", "raw-bunny"}) {
+    const fs::path cloud = data / (std::string(scan) + ".ply");
+    if (!fs::exists(cloud)) continue;
+    for (const char* extension : {".stl", ".ply"}) {
+      const fs::path mesh = dir_ / (std::string("mesh") + extension);
+      const std::string summary = run("mesh \"" + cloud.string() + "\" -o \"" + mesh.string() +
+                                      "\" --tile-points 20000 --json");
+      EXPECT_NE(summary.find("\"in_stride\":true"), std::string::npos) << summary;
+      const std::string from_mesh = stats_object(summary);
+      const std::string from_file = run("stats \"" + mesh.string() + "\" --json");
+      for (const char* key :
+           {"triangles", "vertices", "degenerate_triangles", "duplicate_triangles",
+            "non_manifold_edges", "boundary_edges", "orientation_conflicts",
+            "non_manifold_vertices", "non_manifold_vertices_type1", "non_manifold_vertices_type2",
+            "holes", "components"}) {
+        EXPECT_EQ(number(from_mesh, key), number(from_file, key))
+            << scan << extension << ": " << key;
+      }
+      ++checked;
+    }
+  }
+  if (checked == 0) GTEST_SKIP() << "no scans in " << data << " (set G2S_DATA_DIR)";
+}
+
+}  // namespace
