@@ -1,12 +1,11 @@
-// The G2S mesher (src/grid, src/grow, src/cleanup): Gabriel 2-simplex mesh growing with the
-// discrete priority queue and non-manifold vertex removal of Di Angelo & Giaccari (2011).
-// It works on one tile: a span of points in a local frame, with their global ids, in;
-// triangles in global ids plus the still-open front edges out. docs/algorithm.md explains it.
+// The G2S mesher's options and counts (src/grid, src/grow, src/cleanup): Gabriel 2-simplex mesh
+// growing with the discrete priority queue and non-manifold vertex removal of Di Angelo &
+// Giaccari (2011), docs/algorithm.md. The mesher runs inside the tiled pipeline
+// (include/g2s/pipeline.hpp: mesh_cloud for a cloud in memory, mesh_tiles for a tile source).
 #pragma once
 
 #include <cstdint>
 #include <functional>
-#include <span>
 #include <vector>
 
 #include "g2s/types.hpp"
@@ -51,23 +50,5 @@ struct MeshReport {
   double seconds_grow = 0.0;
   double seconds_cleanup = 0.0;
 };
-
-struct TileMesh {
-  std::vector<Triangle> triangles;  // in global ids
-  std::vector<std::array<Index, 2>>
-      open_edges;  // boundary edges a->b as traversed by their triangle
-  MeshReport report;
-};
-
-// Meshes one tile. xyz: 3 floats per point in a local frame (subtract a tile origin computed in
-// double so floats keep their precision). ids: the global id of each point, or empty for
-// 0..n-1. Deterministic: the result depends only on the points, their ids and the options, not
-// on their order in the span.
-TileMesh mesh_tile(std::span<const float> xyz, std::span<const Index> ids,
-                   const MeshOptions& options);
-
-// Meshes a whole cloud in memory: shifts it to a local frame around its bounding-box centre and
-// calls mesh_tile. Triangles index into cloud.xyz.
-TileMesh mesh_cloud(const PointCloud& cloud, const MeshOptions& options);
 
 }  // namespace g2s

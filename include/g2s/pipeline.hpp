@@ -136,6 +136,13 @@ PipelineSummary mesh_tiles(const TileSource& source, const PipelineOptions& opti
 // The same, collecting the mesh in memory.
 PipelineMesh mesh_tiles(const TileSource& source, const PipelineOptions& options);
 
+// A whole cloud in memory, meshed as `g2s mesh` meshes it: cut into MemoryTiles of at most
+// tile_points points (0: the size plan_memory chooses for the default budget and
+// options.threads, as the CLI does), then mesh_tiles. Triangles index into cloud.xyz. Throws
+// Error(bad_input) for more than 2^32-1 points.
+PipelineMesh mesh_cloud(const PointCloud& cloud, const PipelineOptions& options = {},
+                        std::uint64_t tile_points = 0);
+
 // How `g2s mesh --memory` spends a budget of bytes (peak resident memory, as /usr/bin/time -v
 // reports it): the largest tile, the tiles grown and waiting at once, and the points the tile
 // store's writer sorts per round. Per-point costs measured on the synthetic torus, with the

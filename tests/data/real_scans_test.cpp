@@ -12,7 +12,7 @@
 #include <string>
 
 #include "g2s/io.hpp"
-#include "g2s/mesher.hpp"
+#include "g2s/pipeline.hpp"
 #include "g2s/stats.hpp"
 
 namespace {
@@ -44,7 +44,7 @@ TEST_P(RealScan, MeshIsManifoldOrientedAndMeetsItsBaseline) {
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path << " (set G2S_DATA_DIR)";
   const g2s::PointCloud cloud = g2s::read_points(path);
   ASSERT_GT(cloud.size(), 0u);
-  g2s::TileMesh mesh = g2s::mesh_cloud(cloud, {});
+  g2s::PipelineMesh mesh = g2s::mesh_cloud(cloud);
   const g2s::IndexedMesh indexed{cloud.xyz, std::move(mesh.triangles)};
   const g2s::MeshStats s = g2s::compute_stats(indexed, &cloud);
   const double per_point = static_cast<double>(s.triangles) / static_cast<double>(cloud.size());
@@ -84,9 +84,9 @@ TEST(RealScanGaps, ClosingGapsLeavesFewerHolesAndNoDefect) {
     const g2s::PointCloud cloud = g2s::read_points(path);
     g2s::MeshStats s[2];
     for (const bool close : {false, true}) {
-      g2s::MeshOptions options;
-      options.close_gaps = close;
-      g2s::TileMesh mesh = g2s::mesh_cloud(cloud, options);
+      g2s::PipelineOptions options;
+      options.mesh.close_gaps = close;
+      g2s::PipelineMesh mesh = g2s::mesh_cloud(cloud, options);
       s[close] = g2s::compute_stats({cloud.xyz, std::move(mesh.triangles)}, &cloud);
       EXPECT_EQ(s[close].non_manifold_edges, 0u);
       EXPECT_EQ(s[close].non_manifold_vertices, 0u);

@@ -9,7 +9,7 @@
 #include <filesystem>
 
 #include "g2s/io.hpp"
-#include "g2s/mesher.hpp"
+#include "g2s/pipeline.hpp"
 #include "g2s/stats.hpp"
 #include "g2s/synth.hpp"
 
@@ -25,7 +25,7 @@ std::filesystem::path bunny_path() {
 g2s::MeshStats mesh_perturbed_bunny(const g2s::PerturbOptions& options) {
   const g2s::PointCloud clean = g2s::read_points(bunny_path());
   const g2s::PointCloud cloud = g2s::perturb_cloud(clean, options);
-  g2s::TileMesh mesh = g2s::mesh_cloud(cloud, {});
+  g2s::PipelineMesh mesh = g2s::mesh_cloud(cloud);
   return g2s::compute_stats({cloud.xyz, std::move(mesh.triangles)}, &cloud);
 }
 
