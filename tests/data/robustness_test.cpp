@@ -1,10 +1,12 @@
 // The paper's claim for noisy input (Di Angelo & Giaccari 2011, §5, Tables 3 and 4): with
 // Gaussian noise or outliers added to the Stanford Bunny, G2S still produces no non-manifold
-// vertex. The hardest cases of docs/robustness.md, through the library: sigma = 0.5 mean
+// vertex. The hardest cases of docs/robustness.md, through mesh_cloud (the tiled path `g2s mesh`
+// runs): sigma = 0.5 mean
 // spacings and 20% outliers in the bounding box. No non-manifold edge or vertex, no orientation
 // conflict. scripts/robustness.sh measures the whole series.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 
@@ -26,7 +28,12 @@ g2s::MeshStats mesh_perturbed_bunny(const g2s::PerturbOptions& options) {
   const g2s::PointCloud clean = g2s::read_points(bunny_path());
   const g2s::PointCloud cloud = g2s::perturb_cloud(clean, options);
   g2s::PipelineMesh mesh = g2s::mesh_cloud(cloud);
-  return g2s::compute_stats({cloud.xyz, std::move(mesh.triangles)}, &cloud);
+  const g2s::MeshStats s = g2s::compute_stats({cloud.xyz, std::move(mesh.triangles)}, &cloud);
+  std::printf("%llu points, %llu triangles, %llu boundary edges\n",
+              static_cast<unsigned long long>(cloud.size()),
+              static_cast<unsigned long long>(s.triangles),
+              static_cast<unsigned long long>(s.boundary_edges));
+  return s;
 }
 
 void expect_manifold(const g2s::MeshStats& s, std::uint64_t min_triangles) {
@@ -34,7 +41,8 @@ void expect_manifold(const g2s::MeshStats& s, std::uint64_t min_triangles) {
   EXPECT_EQ(s.non_manifold_vertices, 0u);
   EXPECT_EQ(s.orientation_conflicts, 0u);
   EXPECT_EQ(s.duplicate_triangles, 0u);
-  // The surface is still meshed (the clean bunny gives 71,835 triangles).
+  // The surface is still meshed (the clean bunny gives 71,840 triangles; measured through
+  // mesh_cloud: 68,753 with the noise, 75,629 with the outliers).
   EXPECT_GE(s.triangles, min_triangles);
 }
 
@@ -43,7 +51,7 @@ TEST(Robustness, BunnyWithNoiseHalfTheSpacingStaysManifold) {
     GTEST_SKIP() << "no " << bunny_path() << " (set G2S_DATA_DIR)";
   g2s::PerturbOptions options;
   options.noise = 0.5;
-  expect_manifold(mesh_perturbed_bunny(options), 60'000);
+  expect_manifold(mesh_perturbed_bunny(options), 65'000);
 }
 
 TEST(Robustness, BunnyWithTwentyPercentOutliersStaysManifold) {
