@@ -45,7 +45,7 @@ struct MeshReport {
   std::uint64_t triangles_removed = 0;  // by the non-manifold pass
   std::uint64_t non_manifold_vertices_fixed = 0;
   std::uint64_t components_flipped = 0;  // components reoriented at the end
-  double spacing = 0.0;                  // estimated mean nearest-neighbour spacing
+  double spacing = 0.0;                  // estimated median nearest-neighbour distance
   double seconds_grid = 0.0;
   double seconds_grow = 0.0;
   double seconds_cleanup = 0.0;

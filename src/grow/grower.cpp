@@ -414,14 +414,12 @@ class Grower {
       for (const PoolPoint& q : pool_) {
         if (q.walk.dist2 - 2 * along * q.ahead <= 0.25 * len * len) cand_.push_back(q.walk);
       }
-      while (!cand_.empty()) {
-        const Index p = gabriel_walk(a, b, cand_);
-        if (p == kNoIndex) break;
-        const Vec3 n_new = normalized(cross(a - b, grid_.position(p) - b));
-        const int flat = flatness(std::clamp(dot(n, n_new), -1.0, 1.0));
-        if (flat >= 0 && growable(p)) return {p, level * flat_levels_ + flat};
-        break;  // a fold, or context the run may not use
-      }
+      const Index p = cand_.empty() ? kNoIndex : gabriel_walk(a, b, cand_);
+      if (p == kNoIndex) continue;
+      const Vec3 n_new = normalized(cross(a - b, grid_.position(p) - b));
+      const int flat = flatness(std::clamp(dot(n, n_new), -1.0, 1.0));
+      if (flat >= 0 && growable(p)) return {p, level * flat_levels_ + flat};
+      // A fold, or context the run may not use: the next level may find another point.
     }
     return {};
   }
