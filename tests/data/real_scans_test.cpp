@@ -15,13 +15,11 @@
 #include "g2s/io.hpp"
 #include "g2s/pipeline.hpp"
 #include "g2s/stats.hpp"
+#include "support/cli.hpp"
 
 namespace {
 
-std::filesystem::path data_dir() {
-  const char* env = std::getenv("G2S_DATA_DIR");
-  return env && *env ? std::filesystem::path(env) : std::filesystem::path(G2S_DEFAULT_DATA_DIR);
-}
+using g2s::test_support::data_dir;
 
 struct Baseline {
   const char* name;
@@ -42,7 +40,7 @@ class RealScan : public ::testing::TestWithParam<Baseline> {};
 TEST_P(RealScan, MeshIsManifoldOrientedAndMeetsItsBaseline) {
   const Baseline& b = GetParam();
   const std::filesystem::path path = data_dir() / (std::string(b.name) + ".ply");
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path << " (set G2S_DATA_DIR)";
+  G2S_SKIP_WITHOUT_DATA(path);
   const g2s::PointCloud cloud = g2s::read_points(path);
   ASSERT_GT(cloud.size(), 0u);
   g2s::PipelineMesh mesh = g2s::mesh_cloud(cloud);
@@ -81,7 +79,7 @@ TEST(RealScanGaps, ClosingGapsLeavesFewerHolesAndNoDefect) {
   for (const char* name : {"raw-bunny", "open-table-mug-stereo", "open-lion-photogrammetry"}) {
     SCOPED_TRACE(name);
     const std::filesystem::path path = data_dir() / (std::string(name) + ".ply");
-    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path << " (set G2S_DATA_DIR)";
+    G2S_SKIP_WITHOUT_DATA(path);
     const g2s::PointCloud cloud = g2s::read_points(path);
     g2s::MeshStats s[2];
     for (const bool close : {false, true}) {

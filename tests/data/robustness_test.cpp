@@ -14,14 +14,12 @@
 #include "g2s/pipeline.hpp"
 #include "g2s/stats.hpp"
 #include "g2s/synth.hpp"
+#include "support/cli.hpp"
 
 namespace {
 
 std::filesystem::path bunny_path() {
-  const char* env = std::getenv("G2S_DATA_DIR");
-  const std::filesystem::path dir =
-      env && *env ? std::filesystem::path(env) : std::filesystem::path(G2S_DEFAULT_DATA_DIR);
-  return dir / "closed-bunny-zipper.ply";
+  return g2s::test_support::data_dir() / "closed-bunny-zipper.ply";
 }
 
 g2s::MeshStats mesh_perturbed_bunny(const g2s::PerturbOptions& options) {
@@ -47,16 +45,14 @@ void expect_manifold(const g2s::MeshStats& s, std::uint64_t min_triangles) {
 }
 
 TEST(Robustness, BunnyWithNoiseHalfTheSpacingStaysManifold) {
-  if (!std::filesystem::exists(bunny_path()))
-    GTEST_SKIP() << "no " << bunny_path() << " (set G2S_DATA_DIR)";
+  G2S_SKIP_WITHOUT_DATA(bunny_path());
   g2s::PerturbOptions options;
   options.noise = 0.5;
   expect_manifold(mesh_perturbed_bunny(options), 65'000);
 }
 
 TEST(Robustness, BunnyWithTwentyPercentOutliersStaysManifold) {
-  if (!std::filesystem::exists(bunny_path()))
-    GTEST_SKIP() << "no " << bunny_path() << " (set G2S_DATA_DIR)";
+  G2S_SKIP_WITHOUT_DATA(bunny_path());
   g2s::PerturbOptions options;
   options.outliers = 0.2;
   expect_manifold(mesh_perturbed_bunny(options), 70'000);
