@@ -87,7 +87,7 @@ struct PlyBodyResult {
   std::vector<double> xyz;  // empty when streamed to a sink
   std::uint64_t non_finite = 0;
   std::uint64_t streamed = 0;  // points handed to the sink
-  std::size_t end = 0;  // first byte after the last element read
+  std::size_t end = 0;         // first byte after the last element read
 };
 
 // Walks the body of every element in header order (other elements and properties skipped,
