@@ -13,7 +13,7 @@
 namespace g2s {
 
 struct MeshOptions {
-  // Search radius levels (ALGORITHM.md §5): the front search ball has radius
+  // Search radius levels (docs/algorithm.md §4): the front search ball has radius
   // step * max(|ab|, spacing / 2) (at most max_radius spacings), tried in increasing order.
   std::vector<double> radius_steps{1.0, 1.5, 2.0, 3.0};
   // Flatness levels m: the fold angle beta in [0, max_fold_deg] quantised into m levels.
@@ -23,7 +23,7 @@ struct MeshOptions {
   // No search ball is larger than this many spacings (the median nearest-neighbour distance):
   // fronts do not bridge voids, and a query never scans a large part of the cloud.
   double max_radius = 6.0;
-  // Seed search ball radius, in nearest-neighbour edge lengths (§3).
+  // Seed search ball radius, in nearest-neighbour edge lengths (docs/algorithm.md §2).
   double seed_ball = 2.5;
   // Once growth is over, close gaps of three open edges with a triangle where the Point-Edge
   // Map, the orientation groups and the fold limit allow it (docs/algorithm.md §3); off: the

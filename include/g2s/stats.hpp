@@ -1,4 +1,4 @@
-// Defect measurement of any triangle mesh (src/stats/), as defined in ALGORITHM.md §8.
+// Defect measurement of any triangle mesh (src/stats/), as defined in docs/algorithm.md §9.
 // Linear time in the number of triangles (hash tables and a vertex->triangle table, no sorting),
 // single-threaded and deterministic.
 #pragma once

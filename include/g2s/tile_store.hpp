@@ -1,4 +1,4 @@
-// The tile store (src/tiling/, ALGORITHM.md §7.1, docs/tile-store.md): a cloud cut once into
+// The tile store (src/tiling/, docs/tile-store.md): a cloud cut once into
 // spatial point tiles on disk, so that each stage of the out-of-core pipeline loads only the
 // tiles it works on. One file: a versioned header, the tile table, then one block per tile
 // holding its points (double x, y, z) with their global ids, raw or zstd-compressed, each with

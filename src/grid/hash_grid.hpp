@@ -1,4 +1,4 @@
-// Flat hash grid for fixed-radius neighbour search (ALGORITHM.md §2). Points are sorted once
+// Flat hash grid for fixed-radius neighbour search (docs/algorithm.md §1). Points are sorted once
 // into Morton order of their cells (a radix sort), so a cell's points are contiguous and
 // neighbouring cells lie close in memory; non-empty cells are found through an open-addressing
 // hash of their 4x4x4 blocks' Morton codes, so empty space costs nothing. Exact duplicate points

@@ -1,5 +1,5 @@
 // G2S mesh growing, after Di Angelo & Giaccari (2011), "A fast algorithm for manifold
-// reconstruction of surfaces" §3-4, and ALGORITHM.md §3-5. For each free front edge, the
+// reconstruction of surfaces" §3-4, and docs/algorithm.md §2-4. For each free front edge, the
 // Gabriel walk picks the point whose smallest circumscribing ball with the edge holds no other
 // candidate; the discrete priority queue (radius level, then flatness level) meshes the flattest,
 // best-sampled regions first; the Point-Edge Map keeps every edge manifold and every pair of
@@ -269,7 +269,7 @@ class Grower {
     stalled_ = {};
   }
 
-  // Processes front edges until the front is empty (ALGORITHM.md §5).
+  // Processes front edges until the front is empty (docs/algorithm.md §4).
   void drain() {
     FrontEdge e;
     while (!queue_.empty()) {
@@ -479,7 +479,7 @@ class Grower {
     return true;
   }
 
-  // A seed triangle (ALGORITHM.md §3): point i, its nearest unused neighbour, and the nearest
+  // A seed triangle (docs/algorithm.md §2): point i, its nearest unused neighbour, and the nearest
   // third point that makes a Gabriel triangle whose circumcircle's cylinder is not cut by points
   // on both sides (it does not bridge a thin part).
   bool try_seed(Index i) {

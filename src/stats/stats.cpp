@@ -1,4 +1,4 @@
-// Mesh defect measurement (ALGORITHM.md §8): welds vertices by exact position, sets degenerate and
+// Mesh defect measurement (docs/algorithm.md §9, "Measuring a mesh"): welds vertices by exact position, sets degenerate and
 // duplicate triangles aside, then walks every vertex's star once to count edges, fans and holes.
 // Linear time and lean memory: open-addressing hash tables on flat arrays, a CSR vertex->triangle
 // table and union-find, no sorting and no std::unordered_map.

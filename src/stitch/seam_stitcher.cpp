@@ -1,4 +1,4 @@
-// Stage 2 of the tiled pipeline: the seam stitcher (ALGORITHM.md §7.3). Tiles keep only the
+// Stage 2 of the tiled pipeline: the seam stitcher (docs/pipeline.md, "Stage 3: the seam stitcher"). Tiles keep only the
 // triangles with every corner inside them, so a strip of triangles across each seam is missing.
 // Tiles are visited in index order; at tile i the seams with its already visited neighbours are
 // closed by growing G2S over the points within the band width of those seams, with every live

@@ -1,4 +1,4 @@
-// build_tile_store (ALGORITHM.md §7.1, docs/tile-store.md): tiles a cloud in streaming passes
+// build_tile_store (docs/tile-store.md): tiles a cloud in streaming passes
 // with bounded memory. Pass 1 finds the bounding box and a deterministic sample; the box is
 // split k-d style at box midpoints or sample quantiles (tile_split.hpp); when the sample did
 // not hold every point, counting passes check the tiles and re-split any over budget. Then the

@@ -1,4 +1,4 @@
-// Tests of compute_stats (ALGORITHM.md §8) on small hand-made meshes whose answers are known by
+// Tests of compute_stats (docs/algorithm.md §9, "Measuring a mesh") on small hand-made meshes whose answers are known by
 // hand, plus grids whose answers follow from their topology, the JSON/text forms and the
 // `g2s stats` command line.
 #include "g2s/stats.hpp"
