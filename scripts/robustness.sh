@@ -157,7 +157,7 @@ zippered bunny; see \`../shared/data/README.md\`), and mesh the ten merged raw r
 - **Outliers**: \`--outliers F\` appends round(F·n) points uniform in the cloud's bounding box.
 - Both are drawn from a counter-based generator per point (seed 1): the clouds are the same on
   every machine and thread count. \`g2s mesh\` then meshes each cloud with its defaults,
-  \`g2s stats --points CLOUD\` measures it (definitions: \`docs/algorithm.md\`, ALGORITHM.md §8),
+  \`g2s stats --points CLOUD\` measures it (definitions: \`docs/algorithm.md\`, docs/algorithm.md §9),
   and \`g2s render\` draws it.
 - *coverage*: share of the cloud's points that are mesh vertices; *removed by the non-manifold
   pass*: triangles the clean-up (paper §4.1) deleted to make every vertex manifold; *seconds*:

@@ -1,5 +1,5 @@
 // `g2s stats MESH [--points CLOUD] [--json] [--largest-component]`: measures a mesh's defects
-// (ALGORITHM.md §8), or those of its largest piece, and prints them as aligned text or one JSON
+// (docs/algorithm.md §9, "Measuring a mesh"), or those of its largest piece, and prints them as aligned text or one JSON
 // object. Defects are data: exit 0 whenever the mesh could be read and measured; unreadable
 // input exits 3 through g2s::Error.
 #include <fmt/core.h>
