@@ -106,7 +106,7 @@ class MemoryTiles final : public TileSource {
 class TileStore final : public TileSource {
  public:
   explicit TileStore(const std::filesystem::path& store);
-  ~TileStore();
+  ~TileStore() override;
   TileStore(const TileStore&) = delete;
   TileStore& operator=(const TileStore&) = delete;
 

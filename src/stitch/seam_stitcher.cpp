@@ -1,11 +1,11 @@
-// Stage 2 of the tiled pipeline: the seam stitcher (docs/pipeline.md, "Stage 3: the seam stitcher"). Tiles keep only the
-// triangles with every corner inside them, so a strip of triangles across each seam is missing.
-// Tiles are visited in index order; at tile i the seams with its already visited neighbours are
-// closed by growing G2S over the points within the band width of those seams, with every live
-// triangle that touches those points loaded into the Point-Edge Map: their open edges are the
-// front, and no new triangle can give an edge a third triangle or a vertex a crossing fan the
-// clean-up cannot see. Points farther out are loaded as context, so the Gabriel test sees the
-// whole neighbourhood, but are not used.
+// Stage 2 of the tiled pipeline: the seam stitcher (docs/pipeline.md, "Stage 3: the seam
+// stitcher"). Tiles keep only the triangles with every corner inside them, so a strip of triangles
+// across each seam is missing. Tiles are visited in index order; at tile i the seams with its
+// already visited neighbours are closed by growing G2S over the points within the band width of
+// those seams, with every live triangle that touches those points loaded into the Point-Edge Map:
+// their open edges are the front, and no new triangle can give an edge a third triangle or a vertex
+// a crossing fan the clean-up cannot see. Points farther out are loaded as context, so the Gabriel
+// test sees the whole neighbourhood, but are not used.
 //
 // Memory: only the live mesh is kept (stitch/live_mesh.hpp). After each tile the points no later
 // seam can reach are finished and the triangles around them released to the sink

@@ -296,7 +296,8 @@ TEST(Mesher, ThousandCollinearPointsGiveNoTriangles) {
 }
 
 TEST(Mesher, ThousandCoplanarGridPointsAreMeshed) {
-  // 40 x 25 lattice: every quad's four corners are co-circular, the tie-break case of docs/algorithm.md §3.
+  // 40 x 25 lattice: every quad's four corners are co-circular, the tie-break case of
+  // docs/algorithm.md §3.
   PointCloud cloud;
   for (int j = 0; j < 25; ++j) {
     for (int i = 0; i < 40; ++i) cloud.xyz.insert(cloud.xyz.end(), {0.1 * i, 0.1 * j, 2.0});

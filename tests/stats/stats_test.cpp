@@ -1,6 +1,6 @@
-// Tests of compute_stats (docs/algorithm.md §9, "Measuring a mesh") on small hand-made meshes whose answers are known by
-// hand, plus grids whose answers follow from their topology, the JSON/text forms and the
-// `g2s stats` command line.
+// Tests of compute_stats (docs/algorithm.md §9, "Measuring a mesh") on small hand-made meshes whose
+// answers are known by hand, plus grids whose answers follow from their topology, the JSON/text
+// forms and the `g2s stats` command line.
 #include "g2s/stats.hpp"
 
 #include <gtest/gtest.h>
