@@ -1,5 +1,5 @@
 // Micro-benchmarks of the front step's bookkeeping (src/common/edge_map.hpp,
-// src/grow/bucket_queue.hpp; ALGORITHM.md §4-5), which grow_mesh runs once per triangle: the
+// src/grow/bucket_queue.hpp; docs/algorithm.md §3-4), which grow_mesh runs once per triangle: the
 // Point-Edge Map replaying a grown mesh triangle by triangle (one find and one add per edge, as
 // the grower does when it adds a triangle), and the discrete priority queue pushing and popping
 // front edges. The Gabriel walk and the candidate search are private to src/grow/grower.cpp, so

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "g2s/io.hpp"
-#include "g2s/mesher.hpp"
+#include "g2s/pipeline.hpp"
 #include "g2s/synth.hpp"
 
 namespace {
@@ -50,7 +50,7 @@ const Mesh& sphere_mesh() {
     options.shape = g2s::SynthShape::sphere;
     options.points = 200'000;
     Mesh m{g2s::make_synthetic_cloud(options), {}};
-    m.triangles = g2s::mesh_cloud(m.cloud, {}).triangles;
+    m.triangles = g2s::mesh_cloud(m.cloud).triangles;
     return m;
   }();
   return mesh;

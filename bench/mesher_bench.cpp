@@ -1,5 +1,6 @@
 // Micro-benchmarks of the mesher (src/pipeline, src/grow, src/cleanup) on synthetic clouds made
-// in-process: the whole mesh_tile on a 200k-point sphere and a 200k-point noisy terrain, growth
+// in-process: the whole mesher as `g2s mesh` runs it (mesh_cloud: one tile, grown, stitched and
+// cleaned) on a 200k-point sphere and a 200k-point noisy terrain, growth
 // alone, the Gabriel walk alone, and the non-manifold vertex pass on a grown (not yet cleaned)
 // mesh. Times are for
 // comparison over commits on one machine, never asserted. Setup (clouds, grids, grown meshes)
@@ -19,6 +20,7 @@
 
 #include "cleanup/cleanup.hpp"
 #include "g2s/mesher.hpp"
+#include "g2s/pipeline.hpp"
 #include "g2s/synth.hpp"
 #include "grid/hash_grid.hpp"
 #include "grow/gabriel_walk.hpp"
@@ -38,9 +40,9 @@ const tbb::global_control thread_limit(tbb::global_control::max_allowed_parallel
 constexpr std::uint64_t kMeshPoints = 200'000;
 constexpr double kTerrainNoise = 0.2;  // Gaussian sigma, in mean spacings
 
-// A synthetic cloud as the mesher sees it (3 floats each), cached per (shape, points, noise).
-const std::vector<float>& cloud_points(g2s::SynthShape shape, std::uint64_t n, double noise) {
-  static std::map<std::pair<int, std::uint64_t>, std::vector<float>> cache;
+// A synthetic cloud, cached per (shape, points, noise).
+const g2s::PointCloud& cloud_of(g2s::SynthShape shape, std::uint64_t n, double noise) {
+  static std::map<std::pair<int, std::uint64_t>, g2s::PointCloud> cache;
   const std::pair<int, std::uint64_t> key{
       static_cast<int>(shape) * 1000 + static_cast<int>(noise * 100), n};
   auto it = cache.find(key);
@@ -49,8 +51,18 @@ const std::vector<float>& cloud_points(g2s::SynthShape shape, std::uint64_t n, d
     options.shape = shape;
     options.points = n;
     options.noise = noise;
-    const g2s::PointCloud cloud = g2s::make_synthetic_cloud(options);
-    it = cache.emplace(key, std::vector<float>(cloud.xyz.begin(), cloud.xyz.end())).first;
+    it = cache.emplace(key, g2s::make_synthetic_cloud(options)).first;
+  }
+  return it->second;
+}
+
+// The same as the grower sees it (3 floats each).
+const std::vector<float>& cloud_points(g2s::SynthShape shape, std::uint64_t n, double noise) {
+  static std::map<const g2s::PointCloud*, std::vector<float>> cache;
+  const g2s::PointCloud& cloud = cloud_of(shape, n, noise);
+  auto it = cache.find(&cloud);
+  if (it == cache.end()) {
+    it = cache.emplace(&cloud, std::vector<float>(cloud.xyz.begin(), cloud.xyz.end())).first;
   }
   return it->second;
 }
@@ -62,30 +74,30 @@ const std::vector<float>& terrain() {
   return cloud_points(g2s::SynthShape::terrain, kMeshPoints, kTerrainNoise);
 }
 
-// The whole mesher (grid, growth, non-manifold pass, orientation, open edges) on one tile.
-// Counter "triangles/s" = output triangles per wall-clock second.
-void mesh_tile_bench(benchmark::State& state, const std::vector<float>& xyz) {
+// The whole mesher (tiles in memory, grid, growth, clean-up, orientation) as mesh_cloud runs it:
+// one tile for 200k points. Counter "triangles/s" = output triangles per wall-clock second.
+void mesh_cloud_bench(benchmark::State& state, const g2s::PointCloud& cloud) {
   std::uint64_t triangles = 0;
   for (auto _ : state) {
-    const g2s::TileMesh mesh = g2s::mesh_tile(xyz, {}, {});
+    const g2s::PipelineMesh mesh = g2s::mesh_cloud(cloud);
     triangles += mesh.triangles.size();
   }
-  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(xyz.size() / 3));
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(cloud.size()));
   state.counters["triangles"] =
       benchmark::Counter(static_cast<double>(triangles), benchmark::Counter::kAvgIterations);
   state.counters["triangles/s"] =
       benchmark::Counter(static_cast<double>(triangles), benchmark::Counter::kIsRate);
 }
 
-void BM_MeshTile_Sphere200k(benchmark::State& state) {
-  mesh_tile_bench(state, sphere());
+void BM_MeshCloud_Sphere200k(benchmark::State& state) {
+  mesh_cloud_bench(state, cloud_of(g2s::SynthShape::sphere, kMeshPoints, 0));
 }
-BENCHMARK(BM_MeshTile_Sphere200k)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_MeshCloud_Sphere200k)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-void BM_MeshTile_NoisyTerrain200k(benchmark::State& state) {
-  mesh_tile_bench(state, terrain());
+void BM_MeshCloud_NoisyTerrain200k(benchmark::State& state) {
+  mesh_cloud_bench(state, cloud_of(g2s::SynthShape::terrain, kMeshPoints, kTerrainNoise));
 }
-BENCHMARK(BM_MeshTile_NoisyTerrain200k)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_MeshCloud_NoisyTerrain200k)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // Growth alone (seeds, front steps: candidate search, Gabriel walk, priority queue) on a prebuilt
 // grid. Each triangle is one front step, so "triangles/s" is front steps per second; on the noisy

@@ -12,6 +12,7 @@
 
 #include "common/triangle_intersection.hpp"
 #include "g2s/mesher.hpp"
+#include "g2s/pipeline.hpp"
 #include "g2s/stats.hpp"
 #include "g2s/synth.hpp"
 
@@ -29,7 +30,7 @@ const Fixture& million_triangles() {
     options.points = 500'002;  // 2 * 500'002 - 4 = 1'000'000 triangles when closed
     Fixture f;
     f.cloud = g2s::make_synthetic_cloud(options);
-    f.mesh.triangles = g2s::mesh_cloud(f.cloud, {}).triangles;
+    f.mesh.triangles = g2s::mesh_cloud(f.cloud).triangles;
     f.mesh.xyz = f.cloud.xyz;
     return f;
   }();

@@ -147,7 +147,7 @@ The paper (Di Angelo & Giaccari 2011, §5) tests robustness on the Stanford Bunn
 Gaussian noise at three values of its standard deviation σ (its Table 3, Fig. 8) and with 5%,
 10% and 20% outliers (its Table 4, Fig. 9), counting non-manifold vertices n_nmv, holes n_h and
 boundary edges n_be. We do the same on \`closed-bunny-zipper.ply\` (the 35,947 vertices of Stanford's
-zippered bunny; see \`../shared/data/README.md\`), and mesh the ten merged raw range scans
+zippered bunny; see the README beside the scans), and mesh the ten merged raw range scans
 \`raw-bunny.ply\` as they are: real scanner noise, overlapping layers, no synthetic help.
 
 - **Noise**: \`g2s synth --from bunny --noise S\` adds S·s·N(0, 1) independently to x, y and z of
@@ -157,7 +157,7 @@ zippered bunny; see \`../shared/data/README.md\`), and mesh the ten merged raw r
 - **Outliers**: \`--outliers F\` appends round(F·n) points uniform in the cloud's bounding box.
 - Both are drawn from a counter-based generator per point (seed 1): the clouds are the same on
   every machine and thread count. \`g2s mesh\` then meshes each cloud with its defaults,
-  \`g2s stats --points CLOUD\` measures it (definitions: \`docs/algorithm.md\`, ALGORITHM.md §8),
+  \`g2s stats --points CLOUD\` measures it (definitions: \`docs/algorithm.md\`, docs/algorithm.md §9),
   and \`g2s render\` draws it.
 - *coverage*: share of the cloud's points that are mesh vertices; *removed by the non-manifold
   pass*: triangles the clean-up (paper §4.1) deleted to make every vertex manifold; *seconds*:
@@ -270,7 +270,7 @@ decoder). Shading is quantised to 64 levels so every picture fits a PNG palette:
   edge or vertex, and it covers $(percent "${stat[raw,coverage]}") of the 362,272 points.
 
 ## Comparison with the paper
-The copy of the paper we have (\`../shared/seed/\`, text extracted from the PDF) has lost the
+The copy of the paper we have (text extracted from the PDF) has lost the
 numbers of Tables 3 and 4 and the σ values of Fig. 8 (their cells are empty), so only its stated
 findings can be compared, not its figures:
 - "Neither does the new version of G2S generate any non manifold vertices" (with noise and with

@@ -85,7 +85,10 @@ void run_grow(GrowArgs& args) {
                 fmt::format("{}: cannot make the folder for the grown tiles: {}", folder.string(),
                             error ? error.message() : "a file is in the way"));
   }
-  const auto [first, end] = tile_range(args.tiles, store.tiles().size());
+  // Plain variables, not a structured binding: lambdas below capture them (clang before 16
+  // refuses to capture bindings).
+  const std::pair<std::size_t, std::size_t> range = tile_range(args.tiles, store.tiles().size());
+  const std::size_t first = range.first, end = range.second;
   std::unique_ptr<tbb::global_control> limit;
   if (args.threads > 0) {
     limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,

@@ -1,7 +1,7 @@
 // `g2s stats MESH [--points CLOUD] [--json] [--largest-component]`: measures a mesh's defects
-// (docs/algorithm.md §9), or those of its largest piece, and prints them as aligned text or one
-// JSON object. Defects are data: exit 0 whenever the mesh could be read and measured; unreadable
-// input exits 3 through g2s::Error.
+// (docs/algorithm.md §9, "Measuring a mesh"), or those of its largest piece, and prints them as
+// aligned text or one JSON object. Defects are data: exit 0 whenever the mesh could be read and
+// measured; unreadable input exits 3 through g2s::Error.
 #include <fmt/core.h>
 
 #include <cstdio>

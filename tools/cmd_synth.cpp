@@ -56,7 +56,7 @@ std::string expand_count(std::string& text) {
     }
     if (scale != 1.0) number.pop_back();
   }
-  const std::string error =
+  std::string error =
       "expected a positive whole number, optionally with a suffix k, M or "
       "G (500k, 2M, 1.5G), not '" +
       text + "'";

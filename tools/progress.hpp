@@ -6,6 +6,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <string>
 
@@ -38,7 +39,7 @@ class Progress {
   void stage(const char* name, double fraction) {
     if (!enabled_) return;
     const int width = 30;
-    const int done = static_cast<int>(fraction * width + 0.5);
+    const int done = static_cast<int>(std::lround(fraction * width));
     fmt::print(stderr, "\r{:<10} [{:<{}}] {:3.0f}%", name, std::string(done, '#'), width,
                fraction * 100);
     std::fflush(stderr);

@@ -11,9 +11,10 @@ enum class Exit : int {
   ok = 0,
   failure = 1,        // internal error: a bug, please report
   usage = 2,          // bad command line
-  bad_input = 3,      // input missing, unreadable, malformed, or holding no usable points
+  bad_input = 3,      // input missing, unreadable or malformed
   write_failed = 4,   // output could not be written (missing folder, read-only, disk full)
-  no_surface = 5,     // input read, but its points cannot form a surface (none, same, on a line)
+  no_surface = 5,     // input read, but its points cannot form a surface (none usable, all the
+                      // same, on a line, too wide for float, or no triangle found)
   interrupted = 130,  // SIGINT/SIGTERM: temporary files removed, no output left behind
 };
 

@@ -1,12 +1,11 @@
-// The G2S mesher (src/grid, src/grow, src/cleanup): Gabriel 2-simplex mesh growing with the
-// discrete priority queue and non-manifold vertex removal of Di Angelo & Giaccari (2011).
-// It works on one tile: a span of points in a local frame, with their global ids, in;
-// triangles in global ids plus the still-open front edges out. docs/algorithm.md explains it.
+// The G2S mesher's options and counts (src/grid, src/grow, src/cleanup): Gabriel 2-simplex mesh
+// growing with the discrete priority queue and non-manifold vertex removal of Di Angelo &
+// Giaccari (2011), docs/algorithm.md. The mesher runs inside the tiled pipeline
+// (include/g2s/pipeline.hpp: mesh_cloud for a cloud in memory, mesh_tiles for a tile source).
 #pragma once
 
 #include <cstdint>
 #include <functional>
-#include <span>
 #include <vector>
 
 #include "g2s/types.hpp"
@@ -14,7 +13,7 @@
 namespace g2s {
 
 struct MeshOptions {
-  // Search radius levels (ALGORITHM.md §5): the front search ball has radius
+  // Search radius levels (docs/algorithm.md §4): the front search ball has radius
   // step * max(|ab|, spacing / 2) (at most max_radius spacings), tried in increasing order.
   std::vector<double> radius_steps{1.0, 1.5, 2.0, 3.0};
   // Flatness levels m: the fold angle beta in [0, max_fold_deg] quantised into m levels.
@@ -24,7 +23,7 @@ struct MeshOptions {
   // No search ball is larger than this many spacings (the median nearest-neighbour distance):
   // fronts do not bridge voids, and a query never scans a large part of the cloud.
   double max_radius = 6.0;
-  // Seed search ball radius, in nearest-neighbour edge lengths (§3).
+  // Seed search ball radius, in nearest-neighbour edge lengths (docs/algorithm.md §2).
   double seed_ball = 2.5;
   // Once growth is over, close gaps of three open edges with a triangle where the Point-Edge
   // Map, the orientation groups and the fold limit allow it (docs/algorithm.md §3); off: the
@@ -50,28 +49,10 @@ struct MeshReport {
   std::uint64_t triangles_removed = 0;  // by the non-manifold pass
   std::uint64_t non_manifold_vertices_fixed = 0;
   std::uint64_t components_flipped = 0;  // components reoriented at the end
-  double spacing = 0.0;                  // estimated mean nearest-neighbour spacing
+  double spacing = 0.0;                  // estimated median nearest-neighbour distance
   double seconds_grid = 0.0;
   double seconds_grow = 0.0;
   double seconds_cleanup = 0.0;
 };
-
-struct TileMesh {
-  std::vector<Triangle> triangles;  // in global ids
-  std::vector<std::array<Index, 2>>
-      open_edges;  // boundary edges a->b as traversed by their triangle
-  MeshReport report;
-};
-
-// Meshes one tile. xyz: 3 floats per point in a local frame (subtract a tile origin computed in
-// double so floats keep their precision). ids: the global id of each point, or empty for
-// 0..n-1. Deterministic: the result depends only on the points, their ids and the options, not
-// on their order in the span.
-TileMesh mesh_tile(std::span<const float> xyz, std::span<const Index> ids,
-                   const MeshOptions& options);
-
-// Meshes a whole cloud in memory: shifts it to a local frame around its bounding-box centre and
-// calls mesh_tile. Triangles index into cloud.xyz.
-TileMesh mesh_cloud(const PointCloud& cloud, const MeshOptions& options);
 
 }  // namespace g2s

@@ -1,4 +1,4 @@
-// The tile store (src/tiling/, ALGORITHM.md §7.1, docs/tile-store.md): a cloud cut once into
+// The tile store (src/tiling/, docs/tile-store.md): a cloud cut once into
 // spatial point tiles on disk, so that each stage of the out-of-core pipeline loads only the
 // tiles it works on. One file: a versioned header, the tile table, then one block per tile
 // holding its points (double x, y, z) with their global ids, raw or zstd-compressed, each with
@@ -104,13 +104,31 @@ class TileSource {
   std::uint64_t point_count() const;  // points in all tiles
 };
 
+// A cloud cut into tiles in memory: by a k-d split at medians until no tile holds more than
+// tile_points, or by given boxes (which must partition the cloud's bounding box; tests use them
+// to put seams exactly where they want).
+class MemoryTiles final : public TileSource {
+ public:
+  MemoryTiles(const PointCloud& cloud, std::uint64_t tile_points);
+  MemoryTiles(const PointCloud& cloud, std::vector<TileBox> boxes);
+  std::span<const TileInfo> tiles() const override { return info_; }
+  TilePoints load(std::size_t tile) const override;
+  TilePoints load_border(std::size_t tile, double distance) const override;
+
+ private:
+  void finish(std::vector<std::vector<Index>> members);
+  const PointCloud& cloud_;
+  std::vector<TileInfo> info_;
+  std::vector<std::vector<Index>> members_;  // per tile: ids of its points
+};
+
 // A store opened for reading: the header and table are validated on open; a block's checksum
 // is checked each time it is loaded. Any corruption, truncation or version mismatch throws
 // Error(bad_input, "<store>: ...") naming what is wrong. Safe to load from several threads.
 class TileStore final : public TileSource {
  public:
   explicit TileStore(const std::filesystem::path& store);
-  ~TileStore();
+  ~TileStore() override;
   TileStore(const TileStore&) = delete;
   TileStore& operator=(const TileStore&) = delete;
 

@@ -1,4 +1,4 @@
-// Post-processing of a grown mesh: non-manifold vertex removal (ALGORITHM.md §6) and the
+// Post-processing of a grown mesh: non-manifold vertex removal (docs/algorithm.md §5) and the
 // orientation of each component.
 #pragma once
 

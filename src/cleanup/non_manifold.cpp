@@ -1,4 +1,4 @@
-// Non-manifold vertex removal, after Di Angelo & Giaccari (2011) §4.1 and ALGORITHM.md §6.
+// Non-manifold vertex removal, after Di Angelo & Giaccari (2011) §4.1; docs/algorithm.md §5.
 // Instead of the paper's dynamic edge queue we walk each vertex's star directly: the star's
 // triangles are linked across the edges they share at the vertex, giving its fans; when there is
 // more than one, the closed fan (type I) or the largest (type II) is kept and the others are

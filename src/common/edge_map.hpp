@@ -1,4 +1,4 @@
-// The Point-Edge Map of G2S (ALGORITHM.md §4): for every edge of the growing mesh, the first
+// The Point-Edge Map of G2S (docs/algorithm.md §3): for every edge of the growing mesh, the first
 // triangle on it and whether a second one has joined. An edge is kept with its smaller vertex:
 // each vertex has one cache line with room for 7 edges, so a lookup reads one line; the rare
 // vertex with more (and vertices past the count given) spill into an open-addressing table. An

@@ -1,4 +1,4 @@
-// Flat hash grid for fixed-radius neighbour search (ALGORITHM.md §2). Points are sorted once
+// Flat hash grid for fixed-radius neighbour search (docs/algorithm.md §1). Points are sorted once
 // into Morton order of their cells (a radix sort), so a cell's points are contiguous and
 // neighbouring cells lie close in memory; non-empty cells are found through an open-addressing
 // hash of their 4x4x4 blocks' Morton codes, so empty space costs nothing. Exact duplicate points
@@ -33,7 +33,7 @@ class HashGrid {
   std::uint32_t source(std::uint32_t i) const { return sources_[i]; }
   std::span<const Vec3f> points() const { return points_; }
   std::uint64_t duplicates_merged() const { return duplicates_; }
-  double spacing() const { return spacing_; }  // mean nearest-neighbour distance (sampled)
+  double spacing() const { return spacing_; }  // median nearest-neighbour distance (sampled)
   double cell_size() const { return cell_; }
 
   // A ball query as for_each_in_ball answers it: the test and the cells it scans.

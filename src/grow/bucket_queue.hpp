@@ -1,5 +1,5 @@
-// The discrete priority queue of G2S (ALGORITHM.md §5) as a bucket queue: one FIFO per priority
-// value, O(1) push and pop, no heap. Lower priority values are drained first.
+// The discrete priority queue of G2S (docs/algorithm.md §4) as a bucket queue: one FIFO per
+// priority value, O(1) push and pop, no heap. Lower priority values are drained first.
 #pragma once
 
 #include <cstdint>

@@ -1,4 +1,4 @@
-// The Gabriel walk (ALGORITHM.md §1, §4): among the candidate points for front edge ab, the one
+// The Gabriel walk (docs/algorithm.md §3): among the candidate points for front edge ab, the one
 // whose smallest circumscribing ball with a and b holds no other candidate. Start at the
 // candidate nearest the edge midpoint, move to the candidate deepest inside the current ball,
 // stop when none is inside. Every tie (equally near, equally deep, co-circular) goes to the

@@ -1,5 +1,5 @@
 // G2S mesh growing, after Di Angelo & Giaccari (2011), "A fast algorithm for manifold
-// reconstruction of surfaces" §3-4, and ALGORITHM.md §3-5. For each free front edge, the
+// reconstruction of surfaces" §3-4, and docs/algorithm.md §2-4. For each free front edge, the
 // Gabriel walk picks the point whose smallest circumscribing ball with the edge holds no other
 // candidate; the discrete priority queue (radius level, then flatness level) meshes the flattest,
 // best-sampled regions first; the Point-Edge Map keeps every edge manifold and every pair of
@@ -621,7 +621,7 @@ class Grower {
     fill_loop_.clear();
   }
 
-  // Processes front edges until the front is empty (ALGORITHM.md §5).
+  // Processes front edges until the front is empty (docs/algorithm.md §4).
   void drain() {
     FrontEdge e;
     while (!queue_.empty()) {
@@ -766,14 +766,12 @@ class Grower {
       for (const PoolPoint& q : pool_) {
         if (q.walk.dist2 - 2 * along * q.ahead <= 0.25 * len * len) cand_.push_back(q.walk);
       }
-      while (!cand_.empty()) {
-        const Index p = gabriel_walk(a, b, cand_);
-        if (p == kNoIndex) break;
-        const Vec3 n_new = normalized(cross(a - b, grid_.position(p) - b));
-        const int flat = flatness(std::clamp(dot(n, n_new), -1.0, 1.0));
-        if (flat >= 0 && growable(p)) return {p, level * flat_levels_ + flat};
-        break;  // a fold, or context the run may not use
-      }
+      const Index p = cand_.empty() ? kNoIndex : gabriel_walk(a, b, cand_);
+      if (p == kNoIndex) continue;
+      const Vec3 n_new = normalized(cross(a - b, grid_.position(p) - b));
+      const int flat = flatness(std::clamp(dot(n, n_new), -1.0, 1.0));
+      if (flat >= 0 && growable(p)) return {p, level * flat_levels_ + flat};
+      // A fold, or context the run may not use: the next level may find another point.
     }
     return {};
   }
@@ -833,7 +831,7 @@ class Grower {
     return true;
   }
 
-  // A seed triangle (ALGORITHM.md §3): point i, its nearest unused neighbour, and the nearest
+  // A seed triangle (docs/algorithm.md §2): point i, its nearest unused neighbour, and the nearest
   // third point that makes a Gabriel triangle whose circumcircle's cylinder is not cut by points
   // on both sides (it does not bridge a thin part).
   bool try_seed(Index i) {

@@ -1,4 +1,4 @@
-// G2S mesh growing (ALGORITHM.md §3-5) over the points of one hash grid.
+// G2S mesh growing (docs/algorithm.md §2-4) over the points of one hash grid.
 #pragma once
 
 #include <cstdint>

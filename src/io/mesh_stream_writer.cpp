@@ -196,7 +196,8 @@ void MeshStreamWriter::Impl::finish_binary_stl(const Flipped& flipped) {
     facet += run[1];
     if (!flipped(run[0])) return;
     while (lo < facet) {
-      while (lo >= batch + kBatchFacets) rewrite_batch();
+      // rewrite_batch() advances `batch` (a member the check cannot see it change).
+      while (lo >= batch + kBatchFacets) rewrite_batch();  // NOLINT(bugprone-infinite-loop)
       const std::uint64_t hi = std::min(facet, batch + kBatchFacets);
       if (!ranges.empty() && ranges.back()[1] == lo) {
         ranges.back()[1] = hi;

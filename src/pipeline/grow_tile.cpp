@@ -13,10 +13,11 @@
 #include <chrono>
 
 #include "cleanup/cleanup.hpp"
-#include "g2s/pipeline.hpp"
+#include "common/local_frame.hpp"
+#include "g2s/tile_stages.hpp"
 #include "grid/hash_grid.hpp"
 #include "grow/grower.hpp"
-#include "pipeline/tile_geometry.hpp"
+#include "stitch/seam_reach.hpp"
 
 namespace g2s {
 namespace {
@@ -99,14 +100,7 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
       points.xyz.insert(points.xyz.end(), &border.xyz[3 * k], &border.xyz[3 * k + 3]);
     }
   }
-  // Local float frame near the box (frame_origin: exact for float input; georeferenced clouds
-  // keep their precision).
-  const double origin[3] = {frame_origin(box.lo[0], box.hi[0]), frame_origin(box.lo[1], box.hi[1]),
-                            frame_origin(box.lo[2], box.hi[2])};
-  std::vector<float> local(points.xyz.size());
-  for (std::size_t k = 0; k < local.size(); ++k) {
-    local[k] = static_cast<float>(points.xyz[k] - origin[k % 3]);
-  }
+  const std::vector<float> local = LocalFrame(box.lo, box.hi).convert(points.xyz);
   const HashGrid grid(local, points.ids);
   out.report.points = own;
   out.report.spacing = grid.spacing();

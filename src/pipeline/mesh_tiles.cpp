@@ -1,12 +1,14 @@
 // The tiled pipeline in one process: tiles grown as TBB tasks (tiles are independent, so the
-// result does not depend on the thread count) and stitched in tile order as they come.
-#include <tbb/global_control.h>
+// result does not depend on the thread count) and stitched in tile order as they come. The
+// thread count applies to this call only: it runs in its own task arena, and other TBB users of
+// the process keep theirs.
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 #include <time.h>
 
 #include <atomic>
 #include <memory>
+#include <utility>
 
 #include "g2s/pipeline.hpp"
 
@@ -49,43 +51,39 @@ std::uint64_t thread_cpu_ns() {
 
 PipelineSummary mesh_tiles(const TileSource& source, const PipelineOptions& options,
                            MeshSink& sink) {
-  std::unique_ptr<tbb::global_control> limit;
-  if (options.threads > 0) {
-    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                  static_cast<std::size_t>(options.threads));
-  }
+  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   // Tiles grow in parallel while the stitcher, one tile at a time in index order, closes the
   // seams of those already grown; tiles_in_flight bounds the tiles grown and waiting.
   const std::size_t tiles = source.tiles().size();
-  const std::size_t workers =
-      options.threads > 0 ? static_cast<std::size_t>(options.threads)
-                          : static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
+  const auto workers = static_cast<std::size_t>(arena.max_concurrency());
   Stitcher stitcher(source, options, sink);
   std::size_t next = 0;
   std::atomic<std::uint64_t> grow_ns{0};
   std::uint64_t stitch_ns = 0;
-  tbb::parallel_pipeline(
-      options.tiles_in_flight > 0 ? options.tiles_in_flight : 2 * workers,
-      tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
-                                          [&](tbb::flow_control& control) -> std::size_t {
-                                            if (next == tiles) control.stop();
-                                            return next++;
-                                          }) &
-          tbb::make_filter<std::size_t, std::pair<std::size_t, TileGrowth>>(
-              tbb::filter_mode::parallel,
-              [&](std::size_t t) {
-                const std::uint64_t start = thread_cpu_ns();
-                std::pair grown{t, grow_tile(source, t, options)};
-                grow_ns += thread_cpu_ns() - start;
-                return grown;
-              }) &
-          tbb::make_filter<std::pair<std::size_t, TileGrowth>, void>(
-              tbb::filter_mode::serial_in_order, [&](std::pair<std::size_t, TileGrowth> grown) {
-                const std::uint64_t start = thread_cpu_ns();
-                stitcher.add(grown.first, std::move(grown.second));
-                stitch_ns += thread_cpu_ns() - start;
-                if (options.progress) options.progress(grown.first + 1, tiles);
-              }));
+  arena.execute([&] {
+    tbb::parallel_pipeline(
+        options.tiles_in_flight > 0 ? options.tiles_in_flight : 2 * workers,
+        tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
+                                            [&](tbb::flow_control& control) -> std::size_t {
+                                              if (next == tiles) control.stop();
+                                              return next++;
+                                            }) &
+            tbb::make_filter<std::size_t, std::pair<std::size_t, TileGrowth>>(
+                tbb::filter_mode::parallel,
+                [&](std::size_t t) {
+                  const std::uint64_t start = thread_cpu_ns();
+                  std::pair grown{t, grow_tile(source, t, options)};
+                  grow_ns += thread_cpu_ns() - start;
+                  return grown;
+                }) &
+            tbb::make_filter<std::pair<std::size_t, TileGrowth>, void>(
+                tbb::filter_mode::serial_in_order, [&](std::pair<std::size_t, TileGrowth> grown) {
+                  const std::uint64_t start = thread_cpu_ns();
+                  stitcher.add(grown.first, std::move(grown.second));
+                  stitch_ns += thread_cpu_ns() - start;
+                  if (options.progress) options.progress(grown.first + 1, tiles);
+                }));
+  });
   PipelineSummary summary = stitcher.finish();
   summary.cpu_seconds_grow = 1e-9 * static_cast<double>(grow_ns.load());
   summary.cpu_seconds_stitch = 1e-9 * static_cast<double>(stitch_ns);

@@ -1,7 +1,7 @@
-// Mesh defect measurement (docs/algorithm.md §9): welds vertices by exact position, sets degenerate
-// and duplicate triangles aside, then walks every vertex's star once to count edges, fans and
-// holes. Linear time and lean memory: open-addressing hash tables on flat arrays, a CSR
-// vertex->triangle table and union-find, no sorting and no std::unordered_map.
+// Mesh defect measurement (docs/algorithm.md §9, "Measuring a mesh"): welds vertices by exact
+// position, sets degenerate and duplicate triangles aside, then walks every vertex's star once to
+// count edges, fans and holes. Linear time and lean memory: open-addressing hash tables on flat
+// arrays, a CSR vertex->triangle table and union-find, no sorting and no std::unordered_map.
 #include "g2s/stats.hpp"
 
 #include <algorithm>

@@ -1,11 +1,11 @@
-// Stage 2 of the tiled pipeline: the seam stitcher (ALGORITHM.md §7.3). Tiles keep only the
-// triangles with every corner inside them, so a strip of triangles across each seam is missing.
-// Tiles are visited in index order; at tile i the seams with its already visited neighbours are
-// closed by growing G2S over the points within the band width of those seams, with every live
-// triangle that touches those points loaded into the Point-Edge Map: their open edges are the
-// front, and no new triangle can give an edge a third triangle or a vertex a crossing fan the
-// clean-up cannot see. Points farther out are loaded as context, so the Gabriel test sees the
-// whole neighbourhood, but are not used.
+// Stage 2 of the tiled pipeline: the seam stitcher (docs/pipeline.md, "Stage 3: the seam
+// stitcher"). Tiles keep only the triangles with every corner inside them, so a strip of triangles
+// across each seam is missing. Tiles are visited in index order; at tile i the seams with its
+// already visited neighbours are closed by growing G2S over the points within the band width of
+// those seams, with every live triangle that touches those points loaded into the Point-Edge Map:
+// their open edges are the front, and no new triangle can give an edge a third triangle or a vertex
+// a crossing fan the clean-up cannot see. Points farther out are loaded as context, so the Gabriel
+// test sees the whole neighbourhood, but are not used.
 //
 // Memory: only the live mesh is kept (stitch/live_mesh.hpp). After each tile the points no later
 // seam can reach are finished and the triangles around them released to the sink
@@ -21,14 +21,15 @@
 #include <numeric>
 #include <tuple>
 
-#include "cleanup/release.hpp"
 #include "common/id_map.hpp"
+#include "common/local_frame.hpp"
 #include "g2s/error.hpp"
-#include "g2s/pipeline.hpp"
+#include "g2s/tile_stages.hpp"
 #include "grid/hash_grid.hpp"
 #include "grow/grower.hpp"
-#include "pipeline/tile_geometry.hpp"
 #include "stitch/live_mesh.hpp"
+#include "stitch/release.hpp"
+#include "stitch/seam_reach.hpp"
 
 namespace g2s {
 namespace {
@@ -62,7 +63,8 @@ class SeamStitcher {
     local_.clear();
     growable_.clear();
     local_of_.clear();
-    // Positions in a float frame at the tile's centre (offsets computed in double).
+    // Positions in a float frame at the tile's centre.
+    const LocalFrame frame(box.lo, box.hi);
     auto take = [&](Index id, bool in_band, const double* p) {
       if (local_of_.insert(id, static_cast<std::uint32_t>(ids_.size())) != ids_.size()) return;
       // A band point is live (within the tile's reach, so not finished): flag it for the preload.
@@ -70,9 +72,7 @@ class SeamStitcher {
       if (s != IdMap::kMissing) live.flags[s] |= LiveMesh::kInBand;
       ids_.push_back(id);
       growable_.push_back(s != IdMap::kMissing);
-      for (int a = 0; a < 3; ++a) {
-        local_.push_back(static_cast<float>(p[a] - frame_origin(box.lo[a], box.hi[a])));
-      }
+      frame.append(p, local_);
     };
     {
       const TilePoints own = source_.load_border(tile, reach.context);

@@ -10,6 +10,7 @@
 #include <numeric>
 #include <vector>
 
+#include "common/local_frame.hpp"
 #include "g2s/error.hpp"
 #include "g2s/synth.hpp"
 #include "grid/hash_grid.hpp"
@@ -40,15 +41,9 @@ Box bounding_box(const PointCloud& cloud) {
 double mean_spacing(const PointCloud& cloud) {
   if (cloud.size() > kNoIndex)
     throw Error(Exit::bad_input, "cloud has more than 4,294,967,295 points");
-  // The grid works in float: a local frame around the box centre keeps georeferenced clouds'
-  // precision, as mesh_cloud does.
+  // The grid works in float, in the mesher's frame around the box centre.
   const Box box = bounding_box(cloud);
-  std::vector<float> local(cloud.xyz.size());
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    for (int a = 0; a < 3; ++a)
-      local[3 * i + a] = static_cast<float>(cloud.xyz[3 * i + a] - 0.5 * (box.lo[a] + box.hi[a]));
-  }
-  const HashGrid grid(local, {});
+  const HashGrid grid(LocalFrame(box.lo.data(), box.hi.data()).convert(cloud.xyz), {});
   if (grid.size() < 2)
     throw Error(Exit::bad_input, "the spacing of a cloud needs at least two distinct points");
   // Every nearest neighbour lies within the box's diagonal (plus float rounding).

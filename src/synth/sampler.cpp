@@ -161,6 +161,7 @@ std::vector<Patch> make_box(std::uint64_t n, double a, double b, double c) {
   for (double& x : cum) x /= total;
   const std::vector<std::uint64_t> start = split_counts(n, cum);
   std::vector<Patch> patches;
+  patches.reserve(6);
   for (int f = 0; f < 6; ++f)
     patches.push_back(make_rectangle(Patch::Kind::rectangle, faces[f].origin, faces[f].u,
                                      faces[f].v, start[f + 1] - start[f]));

@@ -4,8 +4,7 @@
 #include <algorithm>
 
 #include "g2s/error.hpp"
-#include "g2s/pipeline.hpp"
-#include "pipeline/tile_geometry.hpp"
+#include "g2s/tile_store.hpp"
 #include "tiling/tile_spacing.hpp"
 #include "tiling/tile_split.hpp"
 

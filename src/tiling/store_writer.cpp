@@ -1,4 +1,4 @@
-// build_tile_store (ALGORITHM.md §7.1, docs/tile-store.md): tiles a cloud in streaming passes
+// build_tile_store (docs/tile-store.md): tiles a cloud in streaming passes
 // with bounded memory. Pass 1 finds the bounding box and a deterministic sample; the box is
 // split k-d style at box midpoints or sample quantiles (tile_split.hpp); when the sample did
 // not hold every point, counting passes check the tiles and re-split any over budget. Then the
@@ -96,7 +96,7 @@ std::vector<std::uint64_t> split_into_tiles(const std::filesystem::path& input, 
   tree.split(0, first_sample, first_weight, sampled_target);
   tree.taper(first_sample, first_weight, smallest);
   for (;;) {
-    const std::vector<std::uint64_t> counts = count_leaves(input, tree, first);
+    std::vector<std::uint64_t> counts = count_leaves(input, tree, first);
     std::vector<std::uint32_t> over;
     for (std::uint32_t n = 0; n < tree.node_count(); ++n) {
       if (tree.is_leaf(n) && counts[n] > budget) over.push_back(n);
@@ -404,6 +404,8 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
   store_le(h + header::input_declared, first.declared);
   store_le(h + header::input_points, first.points);
   store_le(h + header::input_non_finite, first.non_finite);
+  // A fixed-width field, zero-padded by the header's initialisation: not a C string.
+  // NOLINTNEXTLINE(bugprone-not-null-terminated-result)
   std::memcpy(h + header::input_format, first.format.data(),
               std::min(first.format.size(), kFormatChars - 1));
   store_le(h + header::table_offset, std::uint64_t{kHeaderBytes});

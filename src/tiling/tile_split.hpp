@@ -1,4 +1,4 @@
-// The adaptive split of the tile store (ALGORITHM.md §7.1, docs/tile-store.md "Adaptive
+// The adaptive split of the tile store (docs/tile-store.md, "Adaptive
 // split"): a k-d tree over the cloud's bounding box whose leaves are the tiles. A leaf holding
 // too many points is cut across its longest axis: at the box's midpoint when that leaves each
 // side at least 1/8 of its points (compact tiles, closing in on dense regions), else at a

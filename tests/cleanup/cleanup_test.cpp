@@ -1,4 +1,4 @@
-// Tests of the post-processing of a grown mesh (src/cleanup/cleanup.hpp, ALGORITHM.md §6):
+// Tests of the post-processing of a grown mesh (src/cleanup/cleanup.hpp, docs/algorithm.md §5):
 // non-manifold vertex removal on hand-made fans whose answer is known, on a cascade, on random
 // damage to a closed surface, and the orientation of whole components.
 #include "cleanup/cleanup.hpp"

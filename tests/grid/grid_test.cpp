@@ -1,4 +1,4 @@
-// Tests of the hash grid (src/grid/hash_grid.hpp, ALGORITHM.md §2): ball queries and nearest
+// Tests of the hash grid (src/grid/hash_grid.hpp, docs/algorithm.md §1): ball queries and nearest
 // neighbours against brute force over awkward clouds, duplicate merging, ids, independence from
 // the input order and the spacing estimate.
 #include <gtest/gtest.h>

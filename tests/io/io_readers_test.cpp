@@ -24,8 +24,10 @@
 #include "g2s/io.hpp"
 #include "io/mapped_file.hpp"
 #include "io/readers.hpp"
+#include "support/cli.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_folder.hpp"
+#include "support/unprivileged.hpp"
 
 namespace {
 
@@ -505,11 +507,15 @@ TEST_F(IoReadOpen, DirectoryGiven) {
 }
 
 TEST_F(IoReadOpen, UnreadableFile) {
-  if (::geteuid() == 0) GTEST_SKIP() << "root reads files whatever their permissions";
   const fs::path path = write("secret.ply", simple_binary_ply(1, 1));
   fs::permissions(path, fs::perms::none);
-  expect_error([&] { g2s::read_points(path); }, Exit::bad_input,
-               {"secret.ply", std::strerror(EACCES)});
+  g2s::test_support::open_to_others(dir_);
+  EXPECT_EQ(g2s::test_support::as_unprivileged([&] {
+              return g2s::test_support::error_mismatch([&] { g2s::read_points(path); },
+                                                       Exit::bad_input,
+                                                       {"secret.ply", std::strerror(EACCES)});
+            }),
+            "");
 }
 
 TEST_F(IoReadOpen, BinaryFileThatIsNotPly) {
@@ -747,10 +753,8 @@ TEST_F(IoMeshReader, BrokenAsciiStl) {
 // ---- the real scans ----
 
 TEST(IoRealData, ReadmePointCounts) {
-  const char* env = std::getenv("G2S_DATA_DIR");
-  const fs::path dir =
-      env != nullptr && *env != '\0' ? fs::path(env) : fs::path(G2S_DEFAULT_DATA_DIR);
-  if (!fs::is_directory(dir)) GTEST_SKIP() << "no data folder " << dir;
+  const fs::path dir = g2s::test_support::data_dir();
+  G2S_SKIP_WITHOUT_DATA(dir);
   const struct {
     const char* file;
     std::uint64_t points;

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "g2s/synth.hpp"
+#include "support/cli.hpp"
 #include "support/temp_folder.hpp"
 
 namespace {
@@ -35,10 +36,7 @@ class PipelineFaults : public ::testing::Test {
 
   // Runs the CLI through bash in the test folder; `prefix` goes before it (e.g. ulimit).
   int run(const std::string& args, const std::string& prefix = "") const {
-    const std::string command = "cd \"" + dir_.string() + "\" && bash -c '" + prefix + " exec \"" +
-                                G2S_CLI_PATH + "\" " + args + "' > /dev/null 2> stderr.txt";
-    const int status = std::system(command.c_str());
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return g2s::test_support::run_cli(args, dir_, prefix).code;
   }
 
   // Starts the CLI, sends `signal` as soon as `ready()` holds (checked every few ms), returns its
@@ -107,7 +105,7 @@ TEST_F(PipelineFaults, FullDiskWhileWritingTheTileStore) {
   EXPECT_EQ(run("tile cloud.ply s.store", kSmallDisk), 4);
   EXPECT_FALSE(fs::exists(dir_ / "s.store"));
   EXPECT_TRUE(temporaries().empty());
-  EXPECT_NE(read(dir_ / "stderr.txt").find("s.store"), std::string::npos);
+  EXPECT_NE(read(dir_ / "cli-stderr.txt").find("s.store"), std::string::npos);
   // g2s mesh fails at its temporary store and leaves nothing either.
   EXPECT_EQ(run("mesh cloud.ply -o out.stl", kSmallDisk), 4);
   EXPECT_FALSE(fs::exists(dir_ / "out.stl"));
@@ -121,7 +119,7 @@ TEST_F(PipelineFaults, FullDiskWhileWritingTheMesh) {
   EXPECT_EQ(run("stitch s.store -o out.stl", "trap \"\" XFSZ; ulimit -f 2048;"), 4);
   EXPECT_FALSE(fs::exists(dir_ / "out.stl"));
   EXPECT_TRUE(temporaries().empty());
-  EXPECT_NE(read(dir_ / "stderr.txt").find("out.stl"), std::string::npos);
+  EXPECT_NE(read(dir_ / "cli-stderr.txt").find("out.stl"), std::string::npos);
 }
 
 TEST_F(PipelineFaults, InterruptedStagesLeaveNothingAndGrowResumes) {
@@ -159,9 +157,9 @@ TEST_F(PipelineFaults, InterruptedStagesLeaveNothingAndGrowResumes) {
   const std::size_t kept = files_in(grown);
   EXPECT_GT(kept, 0u);
   ASSERT_EQ(run("grow s.store"), 0);
-  EXPECT_NE(read(dir_ / "stderr.txt").find(fmt::format("({} already there)", kept)),
+  EXPECT_NE(read(dir_ / "cli-stderr.txt").find(fmt::format("({} already there)", kept)),
             std::string::npos)
-      << read(dir_ / "stderr.txt");
+      << read(dir_ / "cli-stderr.txt");
   // stitch: stopped while it writes the mesh, nothing is left; run again, it gives the mesh of
   // one g2s mesh run.
   const int code = interrupt({"stitch", "s.store", "-o", "s.stl"}, SIGTERM, writing);

@@ -12,6 +12,7 @@
 #include <sstream>
 #include <string>
 
+#include "support/cli.hpp"
 #include "support/temp_folder.hpp"
 
 namespace {
@@ -38,30 +39,18 @@ class PipelineMemory : public ::testing::Test {
 
   // Runs g2s with `args` in the test folder; returns the exit code, stdout in `out`.
   int run(const std::string& args, std::string* out = nullptr) {
-    const std::string command = "cd \"" + dir_.path().string() + "\" && \"" + G2S_CLI_PATH + "\" " +
-                                args + " > stdout.txt 2> stderr.txt";
-    const int status = std::system(command.c_str());
-    std::ifstream file(dir_.path() / "stdout.txt");
-    std::stringstream text;
-    text << file.rdbuf();
-    if (out) *out = text.str();
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    last_ = g2s::test_support::run_cli(args, dir_.path());
+    if (out) *out = last_.out;
+    return last_.code;
   }
 
-  std::string stderr_text() {
-    std::ifstream file(dir_.path() / "stderr.txt");
-    std::stringstream text;
-    text << file.rdbuf();
-    return text.str();
-  }
+  std::string stderr_text() const { return last_.err; }
 
-  // The number after "key": in a JSON object, or -1.
   static double number(const std::string& json, const std::string& key) {
-    const std::string quoted = "\"" + key + "\":";
-    const std::size_t at = json.find(quoted);
-    if (at == std::string::npos) return -1;
-    return std::strtod(json.c_str() + at + quoted.size(), nullptr);  // skips the blanks
+    return g2s::test_support::json_number(json, key);
   }
+
+  g2s::test_support::CliRun last_;
 
   TempFolder dir_;
 };

@@ -18,6 +18,7 @@
 #include "g2s/pipeline.hpp"
 #include "g2s/stats.hpp"
 #include "g2s/synth.hpp"
+#include "support/cli.hpp"
 #include "support/temp_folder.hpp"
 
 namespace {
@@ -37,12 +38,9 @@ class Stages : public ::testing::Test {
 
   // Runs the CLI in the test folder; returns its exit code, stderr in `err`.
   int run(const std::string& args, std::string* err = nullptr) const {
-    const fs::path log = dir_ / "stderr.txt";
-    const std::string command = "cd \"" + dir_.string() + "\" && \"" + G2S_CLI_PATH + "\" " + args +
-                                " > /dev/null 2> \"" + log.string() + "\"";
-    const int status = std::system(command.c_str());
-    if (err) *err = read(log);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    const g2s::test_support::CliRun r = g2s::test_support::run_cli(args, dir_);
+    if (err) *err = r.err;
+    return r.code;
   }
   static std::string read(const fs::path& file) {
     std::ifstream in(file, std::ios::binary);

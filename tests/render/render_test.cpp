@@ -19,6 +19,7 @@
 
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
+#include "support/cli.hpp"
 
 namespace {
 
@@ -361,12 +362,7 @@ TEST(Render, CommandLine) {
   std::filesystem::create_directories(dir);
   const g2s::IndexedMesh mesh = tetrahedron();
   g2s::write_mesh(dir / "tet.ply", mesh.xyz, mesh.triangles, g2s::MeshFormat::ply_binary);
-  auto run = [&](const std::string& args) {
-    const std::string command = std::string("\"") + G2S_CLI_PATH + "\" " + args + " > \"" +
-                                (dir / "out.txt").string() + "\" 2>&1";
-    const int status = std::system(command.c_str());
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  };
+  auto run = [&](const std::string& args) { return g2s::test_support::run_cli(args, dir).code; };
   const std::string in = " \"" + (dir / "tet.ply").string() + "\"";
   const std::string out = " -o \"" + (dir / "tet.png").string() + "\"";
   ASSERT_EQ(run("render" + in + out + " --size 120x90 --view 45,30 --up y"), 0);

@@ -12,6 +12,7 @@
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
 #include "g2s/stats.hpp"
+#include "support/cli.hpp"
 
 namespace {
 
@@ -58,13 +59,10 @@ TEST(LargestComponent, CommandLine) {
   std::filesystem::create_directories(dir);
   const g2s::IndexedMesh mesh = three_pieces();
   g2s::write_mesh(dir / "pieces.ply", mesh.xyz, mesh.triangles, g2s::MeshFormat::ply_binary);
-  const std::string command = std::string("\"") + G2S_CLI_PATH + "\" stats \"" +
-                              (dir / "pieces.ply").string() + "\" --largest-component --json > \"" +
-                              (dir / "out.txt").string() + "\"";
-  const int status = std::system(command.c_str());
-  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
-  std::ifstream in(dir / "out.txt");
-  const std::string json((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const g2s::test_support::CliRun run = g2s::test_support::run_cli(
+      "stats \"" + (dir / "pieces.ply").string() + "\" --largest-component --json", dir);
+  ASSERT_EQ(run.code, 0) << run.err;
+  const std::string& json = run.out;
   EXPECT_NE(json.find("\"triangles\": 4,"), std::string::npos) << json;
   EXPECT_NE(json.find("\"components\": 1"), std::string::npos) << json;
   std::filesystem::remove_all(dir);

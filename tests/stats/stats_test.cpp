@@ -1,6 +1,6 @@
-// Tests of compute_stats (ALGORITHM.md §8) on small hand-made meshes whose answers are known by
-// hand, plus grids whose answers follow from their topology, the JSON/text forms and the
-// `g2s stats` command line.
+// Tests of compute_stats (docs/algorithm.md §9, "Measuring a mesh") on small hand-made meshes whose
+// answers are known by hand, plus grids whose answers follow from their topology, the JSON/text
+// forms and the `g2s stats` command line.
 #include "g2s/stats.hpp"
 
 #include <gtest/gtest.h>
@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "g2s/error.hpp"
+#include "support/cli.hpp"
 
 namespace {
 
@@ -560,13 +561,9 @@ class StatsCli : public ::testing::Test {
 
   // Runs the CLI with `args`; returns its exit code and fills `output` with its stdout.
   int run(const std::string& args, std::string& output) {
-    const auto out_path = dir_ / "out.txt";
-    const std::string command =
-        std::string("\"") + G2S_CLI_PATH + "\" " + args + " > \"" + out_path.string() + "\" 2>&1";
-    const int status = std::system(command.c_str());
-    std::ifstream in(out_path);
-    output.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    const g2s::test_support::CliRun r = g2s::test_support::run_cli(args, dir_);
+    output = r.out + r.err;
+    return r.code;
   }
 
   std::filesystem::path dir_;

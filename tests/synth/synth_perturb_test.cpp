@@ -17,6 +17,7 @@
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
 #include "g2s/synth.hpp"
+#include "support/cli.hpp"
 
 namespace {
 
@@ -159,13 +160,9 @@ class SynthPerturbFiles : public ::testing::Test {
 
   // Runs the CLI with `args`; returns its exit code and fills `output` with stdout and stderr.
   int run(const std::string& args, std::string& output) {
-    const auto out_path = dir_ / "out.txt";
-    const std::string command =
-        std::string("\"") + G2S_CLI_PATH + "\" " + args + " > \"" + out_path.string() + "\" 2>&1";
-    const int status = std::system(command.c_str());
-    std::ifstream in(out_path);
-    output.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    const g2s::test_support::CliRun r = g2s::test_support::run_cli(args, dir_);
+    output = r.out + r.err;
+    return r.code;
   }
 
   std::filesystem::path dir_;

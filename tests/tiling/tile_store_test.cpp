@@ -31,6 +31,7 @@
 #include "g2s/io.hpp"
 #include "g2s/synth.hpp"
 #include "io/readers.hpp"
+#include "support/cli.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_folder.hpp"
 #include "tiling/store_format.hpp"
@@ -505,10 +506,8 @@ TEST_F(TileStoreDamage, VersionMagicAndEmptyFile) {
 // ---- a real scan and the command line ----
 
 TEST_F(TileStoreTest, RealScanBun000At1000PointsPerTile) {
-  const char* env = std::getenv("G2S_DATA_DIR");
-  const fs::path data = env && *env ? fs::path(env) : fs::path(G2S_DEFAULT_DATA_DIR);
-  const fs::path input = data / "open-bunny-scan-bun000.ply";
-  if (!fs::exists(input)) GTEST_SKIP() << "no " << input << " (set G2S_DATA_DIR)";
+  const fs::path input = g2s::test_support::data_dir() / "open-bunny-scan-bun000.ply";
+  G2S_SKIP_WITHOUT_DATA(input);
   const g2s::PointCloud cloud = g2s::read_points(input);
   const g2s::TileStore store(build(input, "bun000.tiles", 1000, true));
   EXPECT_GE(store.tiles().size(), (cloud.size() + 999) / 1000);
@@ -521,12 +520,11 @@ TEST_F(TileStoreTest, RealScanBun000At1000PointsPerTile) {
   }
 }
 
+// Runs the CLI in the folder of out_path; output: its stdout and stderr.
 int run_cli(const std::string& args, const fs::path& out_path, std::string& output) {
-  const std::string command =
-      std::string("\"") + G2S_CLI_PATH + "\" " + args + " > \"" + out_path.string() + "\" 2>&1";
-  const int status = std::system(command.c_str());
-  output = read_bytes(out_path);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  const g2s::test_support::CliRun r = g2s::test_support::run_cli(args, out_path.parent_path());
+  output = r.out + r.err;
+  return r.code;
 }
 
 TEST_F(TileStoreTest, CliTileAndTileInfo) {

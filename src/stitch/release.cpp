@@ -2,7 +2,7 @@
 // after the last step that can touch it (LiveMesh), so its star is complete: its fans can be
 // judged exactly as the in-memory pass would. A triangle with three released corners can change
 // no more except for the orientation of its group, decided at the very end.
-#include "cleanup/release.hpp"
+#include "stitch/release.hpp"
 
 #include <utility>
 

@@ -1,6 +1,7 @@
 // The global clean-up of the tiled pipeline, run after every stitched tile on the points that
-// tile finishes (ALGORITHM.md §6 applied as the sweep goes): their extra fans are removed, then
-// every live triangle whose corners are all finished is handed to the sink and leaves memory.
+// tile finishes (docs/algorithm.md, "Non-manifold vertices", applied as the sweep goes): their
+// extra fans are removed, then every live triangle whose corners are all finished is handed to the
+// sink and leaves memory.
 #pragma once
 
 #include <cstddef>

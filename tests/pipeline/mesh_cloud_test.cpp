@@ -1,8 +1,7 @@
-// End-to-end tests of the mesher through the public API (include/g2s/mesher.hpp): mesh quality on
-// synthetic shapes measured with compute_stats (ALGORITHM.md §8), determinism and independence
-// from the input order, duplicate merging, degenerate inputs, georeferenced coordinates and the
-// open front edges handed to the stitcher.
-#include "g2s/mesher.hpp"
+// End-to-end tests of the mesher through mesh_cloud (include/g2s/pipeline.hpp), the library path
+// `g2s mesh` runs: mesh quality on synthetic shapes measured with compute_stats
+// (docs/algorithm.md, "Measuring a mesh"), determinism and independence from the input order,
+// duplicate merging, degenerate inputs and georeferenced coordinates.
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -17,12 +16,12 @@
 #include <cstdint>
 #include <cstdio>
 #include <functional>
-#include <map>
 #include <numeric>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "g2s/pipeline.hpp"
 #include "g2s/stats.hpp"
 #include "g2s/synth.hpp"
 #include "support/run_with_deadline.hpp"
@@ -34,9 +33,9 @@ using g2s::test_support::run_with_deadline;
 using g2s::Index;
 using g2s::IndexedMesh;
 using g2s::MeshStats;
+using g2s::PipelineMesh;
 using g2s::PointCloud;
 using g2s::SynthShape;
-using g2s::TileMesh;
 using g2s::Triangle;
 
 PointCloud synth(SynthShape shape, std::uint64_t points, std::uint64_t seed = 1) {
@@ -69,7 +68,7 @@ double signed_volume(const PointCloud& cloud, const std::vector<Triangle>& trian
 }
 
 // Prints and records the numbers that matter, so a failing or drifting run shows them.
-void report(const std::string& name, const TileMesh& mesh, const MeshStats& s) {
+void report(const std::string& name, const PipelineMesh& mesh, const MeshStats& s) {
   const double per_point = s.input_points ? double(s.triangles) / double(s.input_points) : 0.0;
   std::printf(
       "[%s] points %llu triangles %llu (%.4f/point) boundary %llu holes %llu components %llu "
@@ -108,7 +107,7 @@ void expect_manifold(const MeshStats& s, const std::string& name) {
 
 void expect_good_closed_surface(SynthShape shape, const std::string& name) {
   const PointCloud cloud = synth(shape, 20'000);
-  const TileMesh mesh = g2s::mesh_cloud(cloud, {});
+  const PipelineMesh mesh = g2s::mesh_cloud(cloud);
   const MeshStats s = stats_of(cloud, mesh.triangles);
   report(name, mesh, s);
   expect_manifold(s, name);
@@ -121,7 +120,6 @@ void expect_good_closed_surface(SynthShape shape, const std::string& name) {
   EXPECT_GE(s.coverage, 0.995) << name;
   EXPECT_EQ(s.components, 1u) << name;
   EXPECT_GT(signed_volume(cloud, mesh.triangles), 0) << name << ": faces inward";
-  EXPECT_EQ(mesh.open_edges.size(), s.boundary_edges) << name;
   EXPECT_EQ(mesh.report.points, cloud.size());
   EXPECT_EQ(mesh.report.duplicates_merged, 0u);
 }
@@ -136,14 +134,13 @@ TEST(Mesher, TorusOf20kPointsIsAClosedManifoldFacingOutward) {
 
 TEST(Mesher, TerrainIsAManifoldOpenSurfaceFacingUp) {
   const PointCloud cloud = synth(SynthShape::terrain, 20'000);
-  const TileMesh mesh = g2s::mesh_cloud(cloud, {});
+  const PipelineMesh mesh = g2s::mesh_cloud(cloud);
   const MeshStats s = stats_of(cloud, mesh.triangles);
   report("terrain", mesh, s);
   expect_manifold(s, "terrain");
   EXPECT_GE(s.coverage, 0.99);
   EXPECT_EQ(s.components, 1u);
   EXPECT_LE(s.holes, 3u);  // measured: 1, the outer boundary
-  EXPECT_EQ(mesh.open_edges.size(), s.boundary_edges);
   // A patch of V vertices and B boundary edges triangulated without holes has 2V - B - 2
   // triangles.
   EXPECT_GE(double(s.triangles), 0.98 * double(2 * s.vertices - s.boundary_edges - 2));
@@ -157,30 +154,9 @@ TEST(Mesher, TerrainIsAManifoldOpenSurfaceFacingUp) {
   EXPECT_GT(nz, 0.9);  // the patch covers [0,1]^2: about 1 when facing up, -1 when down
 }
 
-TEST(Mesher, OpenEdgesOfATerrainTileAreItsBoundaryEdges) {
-  const PointCloud cloud = synth(SynthShape::terrain, 10'000, 3);
-  const TileMesh mesh = g2s::mesh_cloud(cloud, {});
-  const MeshStats s = stats_of(cloud, mesh.triangles);
-  ASSERT_GT(s.boundary_edges, 0u);
-  EXPECT_EQ(mesh.open_edges.size(), s.boundary_edges);
-  // Each open edge a->b is traversed a->b by exactly one triangle and b->a by none.
-  std::map<std::pair<Index, Index>, int> directed;
-  for (const Triangle& t : mesh.triangles) {
-    for (int k = 0; k < 3; ++k) ++directed[{t[k], t[(k + 1) % 3]}];
-  }
-  auto uses = [&](Index u, Index v) {
-    const auto it = directed.find({u, v});
-    return it == directed.end() ? 0 : it->second;
-  };
-  for (const auto& e : mesh.open_edges) {
-    EXPECT_EQ(uses(e[0], e[1]), 1) << e[0] << "->" << e[1];
-    EXPECT_EQ(uses(e[1], e[0]), 0) << e[0] << "->" << e[1];
-  }
-}
-
 void expect_manifold_hard_shape(SynthShape shape, const std::string& name) {
   const PointCloud cloud = synth(shape, 20'000);
-  const TileMesh mesh = g2s::mesh_cloud(cloud, {});
+  const PipelineMesh mesh = g2s::mesh_cloud(cloud);
   const MeshStats s = stats_of(cloud, mesh.triangles);
   report(name, mesh, s);
   EXPECT_EQ(s.non_manifold_edges, 0u) << name;
@@ -212,37 +188,34 @@ std::vector<Triangle> canonical_set(std::vector<Triangle> t) {
   return t;
 }
 
-std::vector<float> as_floats(const PointCloud& cloud) {
-  return std::vector<float>(cloud.xyz.begin(), cloud.xyz.end());
-}
-
 TEST(Mesher, MeshingTheSameCloudTwiceGivesIdenticalTriangles) {
   const PointCloud cloud = synth(SynthShape::torus, 10'000, 7);
-  const TileMesh a = g2s::mesh_cloud(cloud, {});
-  const TileMesh b = g2s::mesh_cloud(cloud, {});
+  const PipelineMesh a = g2s::mesh_cloud(cloud);
+  const PipelineMesh b = g2s::mesh_cloud(cloud);
   ASSERT_GT(a.triangles.size(), 19'000u);
   EXPECT_EQ(a.triangles, b.triangles);
-  EXPECT_EQ(a.open_edges, b.open_edges);
 }
 
-TEST(Mesher, ShuffledInputWithPermutedIdsGivesTheSameTriangles) {
+TEST(Mesher, ShuffledInputGivesTheSameTriangles) {
   const PointCloud cloud = synth(SynthShape::sphere, 10'000, 5);
-  const std::vector<float> xyz = as_floats(cloud);
-  const TileMesh reference = g2s::mesh_tile(xyz, {}, {});
+  const PipelineMesh reference = g2s::mesh_cloud(cloud);
   ASSERT_GT(reference.triangles.size(), 19'000u);
   std::mt19937_64 rng(42);
   for (int round = 0; round < 2; ++round) {
-    std::vector<Index> perm(cloud.size());
+    std::vector<Index> perm(cloud.size());  // point k of the shuffled cloud is point perm[k]
     std::iota(perm.begin(), perm.end(), 0u);
     std::shuffle(perm.begin(), perm.end(), rng);
-    std::vector<float> shuffled;
-    shuffled.reserve(xyz.size());
-    for (Index k : perm)
-      shuffled.insert(shuffled.end(), xyz.begin() + 3 * k, xyz.begin() + 3 * k + 3);
-    const TileMesh mesh = g2s::mesh_tile(shuffled, perm, {});
+    PointCloud shuffled;
+    shuffled.xyz.reserve(cloud.xyz.size());
+    for (Index k : perm) {
+      shuffled.xyz.insert(shuffled.xyz.end(), cloud.xyz.begin() + 3 * k,
+                          cloud.xyz.begin() + 3 * k + 3);
+    }
+    PipelineMesh mesh = g2s::mesh_cloud(shuffled);
+    for (Triangle& t : mesh.triangles) {
+      for (Index& v : t) v = perm[v];
+    }
     EXPECT_EQ(canonical_set(mesh.triangles), canonical_set(reference.triangles));
-    // The documented promise is stronger: the result does not depend on the order at all.
-    EXPECT_EQ(mesh.triangles, reference.triangles);
   }
 }
 
@@ -255,8 +228,8 @@ TEST(Mesher, EveryPointDoubledGivesTheSameTrianglesAndCountsTheDuplicates) {
     const PointCloud cloud = synth(shape, 5'000, 9);
     PointCloud doubled = cloud;
     doubled.xyz.insert(doubled.xyz.end(), cloud.xyz.begin(), cloud.xyz.end());
-    const TileMesh single = g2s::mesh_cloud(cloud, {});
-    const TileMesh twice = g2s::mesh_cloud(doubled, {});
+    const PipelineMesh single = g2s::mesh_cloud(cloud);
+    const PipelineMesh twice = g2s::mesh_cloud(doubled);
     EXPECT_EQ(twice.report.duplicates_merged, cloud.size()) << name;
     EXPECT_EQ(twice.report.points, doubled.size()) << name;
     ASSERT_GT(single.triangles.size(), 9'000u) << name;
@@ -269,7 +242,7 @@ TEST(Mesher, EveryPointDoubledGivesTheSameTrianglesAndCountsTheDuplicates) {
 // --- degenerate inputs --------------------------------------------------------------------------
 
 // Whatever comes out must be a valid mesh over the given points.
-void expect_valid(const PointCloud& cloud, const TileMesh& mesh, const std::string& name) {
+void expect_valid(const PointCloud& cloud, const PipelineMesh& mesh, const std::string& name) {
   for (const Triangle& t : mesh.triangles) {
     for (Index v : t) ASSERT_LT(v, cloud.size()) << name;
   }
@@ -293,28 +266,23 @@ TEST(Mesher, TinyAndDegenerateCloudsGiveNoTriangles) {
       {"two identical + one", from_points({{0, 0, 0}, {0, 0, 0}, {1, 0, 0}})},
   };
   for (const auto& [name, cloud] : clouds) {
-    const TileMesh mesh = g2s::mesh_cloud(cloud, {});
+    const PipelineMesh mesh = g2s::mesh_cloud(cloud);
     EXPECT_TRUE(mesh.triangles.empty()) << name;
-    EXPECT_TRUE(mesh.open_edges.empty()) << name;
     EXPECT_EQ(mesh.report.points, cloud.size()) << name;
   }
-  // The empty span through mesh_tile as well.
-  const TileMesh empty = g2s::mesh_tile(std::span<const float>{}, {}, {});
-  EXPECT_TRUE(empty.triangles.empty());
 }
 
 TEST(Mesher, ThreePointsInGeneralPositionGiveOneTriangle) {
   const PointCloud cloud = from_points({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}});
-  const TileMesh mesh = g2s::mesh_cloud(cloud, {});
+  const PipelineMesh mesh = g2s::mesh_cloud(cloud);
   ASSERT_EQ(mesh.triangles.size(), 1u);
   EXPECT_EQ(canonical_set(mesh.triangles), (std::vector<Triangle>{{0, 1, 2}}));  // faces +z
-  EXPECT_EQ(mesh.open_edges.size(), 3u);
 }
 
 TEST(Mesher, AllPointsIdenticalGiveNoTriangles) {
   PointCloud cloud;
   for (int i = 0; i < 1000; ++i) cloud.xyz.insert(cloud.xyz.end(), {4.5, -1.25, 3.0});
-  const TileMesh mesh = g2s::mesh_cloud(cloud, {});
+  const PipelineMesh mesh = g2s::mesh_cloud(cloud);
   EXPECT_TRUE(mesh.triangles.empty());
   EXPECT_EQ(mesh.report.duplicates_merged, 999u);
 }
@@ -322,18 +290,19 @@ TEST(Mesher, AllPointsIdenticalGiveNoTriangles) {
 TEST(Mesher, ThousandCollinearPointsGiveNoTriangles) {
   PointCloud cloud;
   for (int i = 0; i < 1000; ++i) cloud.xyz.insert(cloud.xyz.end(), {0.5 * i, 0.25 * i, -0.1 * i});
-  const TileMesh mesh = g2s::mesh_cloud(cloud, {});
+  const PipelineMesh mesh = g2s::mesh_cloud(cloud);
   expect_valid(cloud, mesh, "collinear");
   EXPECT_TRUE(mesh.triangles.empty());
 }
 
 TEST(Mesher, ThousandCoplanarGridPointsAreMeshed) {
-  // 40 x 25 lattice: every quad's four corners are co-circular, the tie-break case of §1.
+  // 40 x 25 lattice: every quad's four corners are co-circular, the tie-break case of
+  // docs/algorithm.md §3.
   PointCloud cloud;
   for (int j = 0; j < 25; ++j) {
     for (int i = 0; i < 40; ++i) cloud.xyz.insert(cloud.xyz.end(), {0.1 * i, 0.1 * j, 2.0});
   }
-  const TileMesh mesh = g2s::mesh_cloud(cloud, {});
+  const PipelineMesh mesh = g2s::mesh_cloud(cloud);
   const MeshStats s = stats_of(cloud, mesh.triangles);
   report("grid", mesh, s);
   expect_manifold(s, "grid");
@@ -349,8 +318,8 @@ TEST(Mesher, GeoreferencedCoordinatesMeshLikeTheSameCloudAtTheOrigin) {
     far.xyz[3 * i] += 1e7;
     far.xyz[3 * i + 1] += 1e7;
   }
-  const TileMesh near_mesh = g2s::mesh_cloud(at_origin, {});
-  const TileMesh far_mesh = g2s::mesh_cloud(far, {});
+  const PipelineMesh near_mesh = g2s::mesh_cloud(at_origin);
+  const PipelineMesh far_mesh = g2s::mesh_cloud(far);
   const auto n0 = double(near_mesh.triangles.size()), n1 = double(far_mesh.triangles.size());
   std::printf("[georeferenced] triangles at origin %.0f, at 1e7: %.0f\n", n0, n1);
   ASSERT_GT(n0, 19'000);
@@ -377,7 +346,7 @@ TEST(Mesher, SphereWithOnePercentOutliersIsStillMeshedAsOneSurface) {
     o.outliers = 0.01;
     o.seed = seed;
     const PointCloud cloud = g2s::make_synthetic_cloud(o);
-    const TileMesh mesh = g2s::mesh_cloud(cloud, {});
+    const PipelineMesh mesh = g2s::mesh_cloud(cloud);
     PointCloud surface;  // the surface points come first
     surface.xyz.assign(cloud.xyz.begin(), cloud.xyz.begin() + 3 * 5'000);
     IndexedMesh indexed;
@@ -401,7 +370,7 @@ TEST(Mesher, SphereWithOneFarOutlierIsMeshedQuickly) {
   // At the low corner: first in the grid's Morton order, so the spacing estimate samples it.
   cloud.xyz.insert(cloud.xyz.end(), {-1e4, -1e4, -1e4});
   const std::string failure = run_with_deadline(3.0, [&]() -> std::string {
-    const TileMesh mesh = g2s::mesh_cloud(cloud, {});
+    const PipelineMesh mesh = g2s::mesh_cloud(cloud);
     const MeshStats s = stats_of(cloud, mesh.triangles);
     if (s.non_manifold_edges || s.non_manifold_vertices || s.orientation_conflicts) {
       return "not manifold";

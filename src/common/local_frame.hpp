@@ -1,0 +1,53 @@
+// The mesher's float frame. Points are meshed in float (the hash grid and the grower store 3
+// floats a point), relative to an origin near a box: a tile's, a seam's tile, or a whole cloud's
+// (origin() says which). The offset is taken in double before rounding, so georeferenced
+// coordinates (around 1e7) keep float's precision. Every stage converts through here, so the same
+// point of the same box gets the same float wherever it is meshed.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <span>
+#include <vector>
+
+namespace g2s {
+
+class LocalFrame {
+ public:
+  LocalFrame(const double lo[3], const double hi[3]) {
+    for (int a = 0; a < 3; ++a) centre_[a] = origin(lo[a], hi[a]);
+  }
+  // Appends point p (3 doubles) in the frame to `out`.
+  void append(const double* p, std::vector<float>& out) const {
+    for (int a = 0; a < 3; ++a) out.push_back(static_cast<float>(p[a] - centre_[a]));
+  }
+  // All points of xyz (3 doubles each) in the frame.
+  std::vector<float> convert(std::span<const double> xyz) const {
+    std::vector<float> local(xyz.size());
+    for (std::size_t k = 0; k < xyz.size(); ++k) {
+      local[k] = static_cast<float>(xyz[k] - centre_[k % 3]);
+    }
+    return local;
+  }
+
+ private:
+  // The origin on one axis for a box [lo, hi] (and a margin as wide again on each side, for
+  // halos): 0 when that range reaches zero or lies near it for its width, else the range's
+  // centre rounded to a multiple of float's step at the range's smallest magnitude. Either way a
+  // coordinate read as float minus the origin is again a float, exactly: the mesher decides on
+  // the very coordinates the output holds (its crossing test depends on it), while
+  // georeferenced coordinates keep float's precision near the box.
+  static double origin(double lo, double hi) {
+    const double width = hi - lo;
+    const double near = std::min(std::abs(lo - width), std::abs(hi + width));
+    if ((lo - width <= 0 && hi + width >= 0) || !(2 * width < near)) return 0;
+    int exponent = 0;
+    std::frexp(near, &exponent);  // near = f * 2^exponent, f in [0.5, 1)
+    const double step = std::ldexp(1.0, exponent - 24);
+    return std::round(0.5 * (lo + hi) / step) * step;
+  }
+  double centre_[3];
+};
+
+}  // namespace g2s
