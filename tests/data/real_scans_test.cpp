@@ -117,7 +117,7 @@ INSTANTIATE_TEST_SUITE_P(
                       Baseline{"open-table-mug-stereo", false, 0.9918, 8937, 565},
                       Baseline{"open-lion-photogrammetry", false, 0.9942, 24322, 1568},
                       Baseline{"open-autzen-lidar", false, 0.9904, 11950, 463},
-                      Baseline{"open-alpe-selle-photogrammetry", false, 0.985, 2933762, 100858}),
+                      Baseline{"open-alpe-selle-photogrammetry", false, 0.985, 2894439, 85306}),
     [](const ::testing::TestParamInfo<Baseline>& param) {
       std::string name = param.param.name;
       for (char& c : name) {
