@@ -25,10 +25,7 @@ using g2s::test_support::expect_error;
 class HostileReaders : public ::testing::Test {
  protected:
   fs::path write(const std::string& name, std::string_view bytes) {
-    const fs::path path = dir_ / name;
-    std::ofstream out(path, std::ios::binary);
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    return path;
+    return folder_.write(name, bytes);
   }
   g2s::test_support::TempFolder folder_{"g2s-hostile-read"};
   const fs::path dir_ = folder_.path();

@@ -25,8 +25,10 @@ struct CliRun {
   std::string err;     // stderr, or why the run failed
 };
 
+// as_nobody: run it as user nobody through setpriv (a root test run checking permissions; `dir`
+// and the files it reads must be open to others).
 inline CliRun run_cli(const std::filesystem::path& dir, const std::vector<std::string>& args,
-                      double seconds = 60.0) {
+                      double seconds = 60.0, bool as_nobody = false) {
   const std::filesystem::path out_path = dir / "cli.stdout";
   const std::filesystem::path err_path = dir / "cli.stderr";
   const pid_t pid = fork();
@@ -37,10 +39,16 @@ inline CliRun run_cli(const std::filesystem::path& dir, const std::vector<std::s
     if (out < 0 || err < 0 || dup2(out, STDOUT_FILENO) < 0 || dup2(err, STDERR_FILENO) < 0) {
       _exit(127);
     }
-    std::vector<char*> argv{const_cast<char*>("g2s")};
+    std::vector<char*> argv;
+    if (as_nobody) {
+      for (const char* a : {"setpriv", "--reuid=nobody", "--regid=nogroup", "--clear-groups"}) {
+        argv.push_back(const_cast<char*>(a));
+      }
+    }
+    argv.push_back(const_cast<char*>(as_nobody ? G2S_CLI_PATH : "g2s"));
     for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
     argv.push_back(nullptr);
-    execv(G2S_CLI_PATH, argv.data());
+    execv(as_nobody ? "/usr/bin/setpriv" : G2S_CLI_PATH, argv.data());
     _exit(127);
   }
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);

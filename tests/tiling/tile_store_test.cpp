@@ -45,10 +45,7 @@ using g2s::Exit;
 class TileStoreTest : public ::testing::Test {
  protected:
   fs::path write(const std::string& name, std::string_view bytes) {
-    const fs::path path = dir_ / name;
-    std::ofstream out(path, std::ios::binary);
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    return path;
+    return folder_.write(name, bytes);
   }
   // Text XYZ with the doubles printed exactly.
   fs::path write_xyz(const std::string& name, const std::vector<double>& xyz) {
