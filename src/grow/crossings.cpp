@@ -9,18 +9,19 @@
 #include "common/triangle_intersection.hpp"
 
 namespace g2s::detail {
+bool degenerate(std::span<const Vec3f> points, const Triangle& t) {
+  double p[3][3];
+  for (int k = 0; k < 3; ++k)
+    p[k][0] = points[t[k]].x, p[k][1] = points[t[k]].y, p[k][2] = points[t[k]].z;
+  return exact::collinear(p[0], p[1], p[2]);
+}
+
 bool triangles_cross(std::span<const Vec3f> points, const Triangle& a, const Triangle& b) {
-  if (a == b) return false;
-  const Vec3f ta[3] = {points[a[0]], points[a[1]], points[a[2]]};
-  const Vec3f tb[3] = {points[b[0]], points[b[1]], points[b[2]]};
+  if (a[0] == b[0] && a[1] == b[1] && a[2] == b[2]) return false;
   // The exact test takes corners with equal coordinates as shared: in a grid, equal coordinates
   // are one point (exact duplicates are merged), so sharing is by index as well.
-  const auto collinear = [](const Vec3f(&t)[3]) {
-    const double p[3][3] = {
-        {t[0].x, t[0].y, t[0].z}, {t[1].x, t[1].y, t[1].z}, {t[2].x, t[2].y, t[2].z}};
-    return exact::collinear(p[0], p[1], p[2]);
-  };
-  if (collinear(ta) || collinear(tb)) return false;
+  const Vec3f ta[3] = {points[a[0]], points[a[1]], points[a[2]]};
+  const Vec3f tb[3] = {points[b[0]], points[b[1]], points[b[2]]};
   return g2s::triangles_cross(ta, tb);
 }
 
@@ -75,7 +76,11 @@ void TriangleCells::build(Level& level, std::span<const std::uint32_t> members) 
 }
 
 TriangleCells::TriangleCells(std::span<const Vec3f> points, std::span<const Triangle> triangles)
-    : points_(points), triangles_(triangles), boxes_(triangles.size()), size_(triangles.size(), 0) {
+    : points_(points),
+      triangles_(triangles),
+      boxes_(triangles.size()),
+      size_(triangles.size(), 0),
+      degenerate_(triangles.size(), 0) {
   std::vector<float> extents(triangles.size());
   for (std::uint32_t t = 0; t < triangles.size(); ++t) {
     const Triangle& tri = triangles[t];
@@ -86,6 +91,7 @@ TriangleCells::TriangleCells(std::span<const Vec3f> points, std::span<const Tria
     box.hi = {std::max({p0.x, p1.x, p2.x}), std::max({p0.y, p1.y, p2.y}),
               std::max({p0.z, p1.z, p2.z})};
     extents[t] = std::max({box.hi.x - box.lo.x, box.hi.y - box.lo.y, box.hi.z - box.lo.z});
+    degenerate_[t] = detail::degenerate(points, tri);
   }
   // The small cell holds nine triangles in ten whole: the rest are few enough to be looked up
   // from their own, larger cells.

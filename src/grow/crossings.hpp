@@ -19,9 +19,12 @@
 
 namespace g2s::detail {
 
+// True when the triangle's corners lie on one line (exactly).
+bool degenerate(std::span<const Vec3f> points, const Triangle& t);
+
 // True when the closed triangles a and b (corner indices into points, which hold no two equal
-// positions) intersect other than in corners or an edge they share; exact
-// (common/triangle_intersection.hpp). The same triangle twice, and degenerate ones, never cross.
+// positions; neither degenerate) intersect other than in corners or an edge they share; exact
+// (common/triangle_intersection.hpp). The same triangle twice never crosses.
 bool triangles_cross(std::span<const Vec3f> points, const Triangle& a, const Triangle& b);
 
 // Triangles filed by the cell of their bounding box's lower corner, in two sizes of cell: a
@@ -38,8 +41,10 @@ class TriangleCells {
   template <class Visit>
   void for_each_near(const Vec3f& lo, const Vec3f& hi, Visit&& visit) const;
 
-  // Pairs (s, t), s < t, of triangles that cross (triangles_cross), where skip(s) and skip(t)
-  // are false and focus(s) or focus(t) is true. Sorted.
+  bool degenerate(std::uint32_t t) const { return degenerate_[t] != 0; }
+
+  // Pairs (s, t), s < t, of non-degenerate triangles that cross (triangles_cross), where skip(s)
+  // and skip(t) are false and focus(s) or focus(t) is true. Sorted.
   template <class Skip, class Focus>
   std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_pairs(Skip&& skip,
                                                                       Focus&& focus) const;
@@ -76,6 +81,7 @@ class TriangleCells {
   std::span<const Triangle> triangles_;
   std::vector<Box> boxes_;
   std::vector<std::uint8_t> size_;  // per triangle: 0 small, 1 large, 2 huge
+  std::vector<std::uint8_t> degenerate_;
   Level small_, large_;
   std::vector<std::uint32_t> huge_;
 };
@@ -121,7 +127,7 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> TriangleCells::crossing_pai
     const auto test = [&](std::uint32_t i, std::uint32_t j) {
       if (!overlap(small_.boxes[i], small_.boxes[j])) return;
       const std::uint32_t s = small_.filed[i], t = small_.filed[j];
-      if (skip(s) || skip(t) || !(focus(s) || focus(t))) return;
+      if (degenerate_[s] || degenerate_[t] || skip(s) || skip(t) || !(focus(s) || focus(t))) return;
       if (triangles_cross(points_, triangles_[s], triangles_[t])) {
         pairs.push_back({std::min(s, t), std::max(s, t)});
       }
@@ -154,7 +160,10 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> TriangleCells::crossing_pai
   const auto against_all = [&](std::uint32_t t) {
     for_each_near(boxes_[t].lo, boxes_[t].hi, [&](std::uint32_t other) {
       if (other == t || (size_[other] != 0 && other < t)) return;
-      if (skip(t) || skip(other) || !(focus(t) || focus(other))) return;
+      if (degenerate_[t] || degenerate_[other] || skip(t) || skip(other) ||
+          !(focus(t) || focus(other))) {
+        return;
+      }
       if (triangles_cross(points_, triangles_[t], triangles_[other])) {
         pairs.push_back({std::min(t, other), std::max(t, other)});
       }

@@ -593,7 +593,8 @@ class Grower {
       }
       bool crosses = false;
       cells.for_each_near(lo, hi, [&](std::uint32_t other) {
-        crosses = crosses || detail::triangles_cross(grid_.points(), t, triangles_[other]);
+        crosses = crosses || (!cells.degenerate(other) &&
+                              detail::triangles_cross(grid_.points(), t, triangles_[other]));
       });
       if (crosses) return false;
     }
