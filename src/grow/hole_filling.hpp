@@ -12,23 +12,23 @@
 
 namespace g2s::detail {
 
-// Inputs: points; loop, the hole's corners in the order the filling triangles traverse them
-// (each filling triangle is counter-clockwise along it); chord_ok(i, j), for loop positions
-// i < j that are not neighbours on the loop, whether the edge loop[i]-loop[j] may be made (false
-// where the mesh has that edge already); scratch space reused between calls.
-// Output: appends loop.size() - 2 triangles to `out` and returns true, or returns false (out
-// unchanged) when every triangulation needs a forbidden chord or a degenerate triangle.
+// Working arrays of triangulate_loop, kept between calls so that filling allocates once.
 struct HoleScratch {
   std::vector<double> cost;
   std::vector<std::uint16_t> split;
   std::vector<std::size_t> stack;
 };
-template <class ChordOk>
-bool triangulate_loop(std::span<const Vec3f> points, std::span<const Index> loop,
-                      ChordOk&& chord_ok, HoleScratch& scratch, std::vector<Triangle>& out);
 
-double triangle_area(const Vec3f& a, const Vec3f& b, const Vec3f& c);
+inline double triangle_area(const Vec3f& a, const Vec3f& b, const Vec3f& c) {
+  return 0.5 * norm(cross(Vec3(b) - Vec3(a), Vec3(c) - Vec3(a)));
+}
 
+// Inputs: points; loop, the hole's corners in the order the filling triangles traverse them
+// (each filling triangle is counter-clockwise along it; at most 65,535 corners); chord_ok(i, j),
+// for loop positions i < j that are not neighbours on the loop, whether the edge
+// loop[i]-loop[j] may be made (false where the mesh has that edge already); scratch space.
+// Output: appends loop.size() - 2 triangles to `out` and returns true, or returns false (out
+// unchanged) when every triangulation needs a forbidden chord or a degenerate triangle.
 template <class ChordOk>
 bool triangulate_loop(std::span<const Vec3f> points, std::span<const Index> loop,
                       ChordOk&& chord_ok, HoleScratch& scratch, std::vector<Triangle>& out) {
