@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <g2s/error.hpp>
 #include <g2s/io.hpp>
-#include <g2s/mesher.hpp>
+#include <g2s/pipeline.hpp>
 #include <g2s/stats.hpp>
 #include <utility>
 
@@ -15,8 +15,8 @@ int main(int argc, char** argv) {
   }
   try {
     const g2s::PointCloud cloud = g2s::read_points(argv[1]);
-    g2s::MeshOptions options;  // the CLI's defaults; e.g. options.max_fold_deg = 120 on noisy scans
-    g2s::TileMesh mesh = g2s::mesh_cloud(cloud, options);
+    g2s::PipelineOptions options;  // the CLI's defaults; options.mesh holds the mesher's
+    g2s::PipelineMesh mesh = g2s::mesh_cloud(cloud, options);
     // The triangles index into cloud.xyz: the mesh interpolates the points.
     g2s::write_mesh(argv[2], cloud.xyz, mesh.triangles, g2s::mesh_format_for(argv[2], false));
     const g2s::MeshStats stats = g2s::compute_stats({cloud.xyz, std::move(mesh.triangles)}, &cloud);

@@ -21,8 +21,10 @@ int main(int argc, char** argv) {
   try {
     const std::filesystem::path output = argv[2];
     // The tile store lives beside the output while the run needs it.
-    const g2s::TemporaryPath store_path(output.parent_path() /
-                                        ("." + output.filename().string() + ".store"));
+    std::string store_name = ".";
+    store_name += output.filename().string();
+    store_name += ".store";
+    const g2s::TemporaryPath store_path(output.parent_path() / store_name);
     const g2s::MemoryPlan plan = g2s::plan_memory(std::uint64_t{512} << 20, 0);  // a 512 MB budget
     g2s::TileStoreOptions tiling;
     tiling.tile_points = argc == 4 ? std::strtoull(argv[3], nullptr, 10) : plan.tile_points;
