@@ -2,6 +2,10 @@
 // two sizes of cell; the pair test is the exact one of common/triangle_intersection.hpp.
 #include "grow/crossings.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -23,6 +27,103 @@ bool triangles_cross(std::span<const Vec3f> points, const Triangle& a, const Tri
   const Vec3f ta[3] = {points[a[0]], points[a[1]], points[a[2]]};
   const Vec3f tb[3] = {points[b[0]], points[b[1]], points[b[2]]};
   return g2s::triangles_cross(ta, tb);
+}
+
+bool in_empty_ball(const HashGrid& grid, const Triangle& t) {
+  const Vec3 a = grid.position(t[0]), b = grid.position(t[1]), c = grid.position(t[2]);
+  Ball ball;
+  if (!circumball(a, b, c, ball)) return false;
+  const double radius2 = std::max({ball.radius2, norm2(b - ball.centre), norm2(c - ball.centre)});
+  const double size = std::abs(ball.centre.x) + std::abs(ball.centre.y) + std::abs(ball.centre.z);
+  bool empty = true;
+  grid.for_each_in_ball(ball.centre, std::sqrt(radius2) * (1 + 1e-8) + 1e-8 * size,
+                        [&](std::uint32_t j, double) {
+                          if (j != t[0] && j != t[1] && j != t[2]) empty = false;
+                        });
+  return empty;
+}
+
+namespace {
+using Pairs = std::vector<std::pair<std::uint32_t, std::uint32_t>>;
+
+Pairs sorted_union(tbb::enumerable_thread_specific<Pairs>& found) {
+  Pairs pairs;
+  for (const Pairs& part : found) pairs.insert(pairs.end(), part.begin(), part.end());
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  return pairs;
+}
+}  // namespace
+
+Pairs TriangleCells::crossing_pairs() const {
+  tbb::enumerable_thread_specific<Pairs> found;
+  // Small triangles: each cell against itself and its 13 neighbours on the forward side, so
+  // that every pair of cells is met once. Boxes are read in filing order (small_.boxes), so the
+  // pairs of two cells are tested from two short runs of memory.
+  const auto cell_pairs = [&](std::size_t slot, Pairs& pairs) {
+    const auto test = [&](std::uint32_t i, std::uint32_t j) {
+      if (!overlap(small_.boxes[i], small_.boxes[j])) return;
+      const std::uint32_t s = small_.filed[i], t = small_.filed[j];
+      if (degenerate_[s] || degenerate_[t]) return;
+      if (triangles_cross(points_, triangles_[s], triangles_[t])) {
+        pairs.push_back({std::min(s, t), std::max(s, t)});
+      }
+    };
+    const std::uint64_t k = small_.keys[slot];
+    for (std::uint32_t i = small_.begin[slot]; i < small_.end[slot]; ++i) {
+      for (std::uint32_t j = i + 1; j < small_.end[slot]; ++j) test(i, j);
+    }
+    const auto x = static_cast<std::int64_t>(k >> 42) - kBias;
+    const auto y = static_cast<std::int64_t>(k >> 21 & 0x1FFFFF) - kBias;
+    const auto z = static_cast<std::int64_t>(k & 0x1FFFFF) - kBias;
+    for (int d = 14; d < 27; ++d) {  // offsets (dx, dy, dz) after (0, 0, 0) in z-y-x order
+      const std::size_t other = small_.find(key(x + d % 3 - 1, y + d / 3 % 3 - 1, z + d / 9 - 1));
+      if (other == small_.keys.size()) continue;
+      for (std::uint32_t i = small_.begin[slot]; i < small_.end[slot]; ++i) {
+        for (std::uint32_t j = small_.begin[other]; j < small_.end[other]; ++j) test(i, j);
+      }
+    }
+  };
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, small_.keys.size(), 4096),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      Pairs& pairs = found.local();
+                      for (std::size_t slot = range.begin(); slot < range.end(); ++slot) {
+                        if (small_.keys[slot] != kEmpty) cell_pairs(slot, pairs);
+                      }
+                    });
+  // Larger triangles against everything near them (each pair of two larger ones once).
+  Pairs& pairs = found.local();
+  const auto against_all = [&](std::uint32_t t) {
+    for_each_near(boxes_[t].lo, boxes_[t].hi, [&](std::uint32_t other) {
+      if (other == t || (size_[other] != 0 && other < t)) return;
+      if (degenerate_[t] || degenerate_[other]) return;
+      if (triangles_cross(points_, triangles_[t], triangles_[other])) {
+        pairs.push_back({std::min(t, other), std::max(t, other)});
+      }
+    });
+  };
+  for (const std::uint32_t t : large_.filed) against_all(t);
+  for (const std::uint32_t t : huge_) against_all(t);
+  return sorted_union(found);
+}
+
+Pairs TriangleCells::crossing_pairs_involving(std::span<const std::uint32_t> focus) const {
+  tbb::enumerable_thread_specific<Pairs> found;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, focus.size(), 256),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      Pairs& pairs = found.local();
+                      for (std::size_t f = range.begin(); f < range.end(); ++f) {
+                        const std::uint32_t t = focus[f];
+                        if (degenerate_[t]) continue;
+                        for_each_near(boxes_[t].lo, boxes_[t].hi, [&](std::uint32_t other) {
+                          if (other == t || degenerate_[other]) return;
+                          if (triangles_cross(points_, triangles_[t], triangles_[other])) {
+                            pairs.push_back({std::min(t, other), std::max(t, other)});
+                          }
+                        });
+                      }
+                    });
+  return sorted_union(found);
 }
 
 std::int64_t TriangleCells::Level::coord(float v) const {

@@ -4,10 +4,6 @@
 // (docs/algorithm.md, "No crossing triangles").
 #pragma once
 
-#include <tbb/blocked_range.h>
-#include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cstdint>
 #include <span>
@@ -16,11 +12,21 @@
 
 #include "common/vec3.hpp"
 #include "g2s/types.hpp"
+#include "grid/hash_grid.hpp"
 
 namespace g2s::detail {
 
 // True when the triangle's corners lie on one line (exactly).
 bool degenerate(std::span<const Vec3f> points, const Triangle& t);
+
+// True when the ball through the triangle's corners centred in its plane holds no other point of
+// `grid`, none even within 1e-8 of its radius (far beyond the rounding of its centre). Such a
+// triangle is a face of the Delaunay tetrahedralization of the grid's points, and two of them
+// never cross: the difference of the powers of a point with respect to their two spheres is an
+// affine function, positive on one triangle's other corners and negative on the other's, so the
+// triangles can meet only where it is zero, in the corners they share. Only triangles without
+// this certificate need to be searched for crossings, and on a clean scan they are few.
+bool in_empty_ball(const HashGrid& grid, const Triangle& t);
 
 // True when the closed triangles a and b (corner indices into points, which hold no two equal
 // positions; neither degenerate) intersect other than in corners or an edge they share; exact
@@ -43,11 +49,13 @@ class TriangleCells {
 
   bool degenerate(std::uint32_t t) const { return degenerate_[t] != 0; }
 
-  // Pairs (s, t), s < t, of non-degenerate triangles that cross (triangles_cross), where skip(s)
-  // and skip(t) are false and focus(s) or focus(t) is true. Sorted.
-  template <class Skip, class Focus>
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_pairs(Skip&& skip,
-                                                                      Focus&& focus) const;
+  // Every pair (s, t), s < t, of non-degenerate triangles that cross (triangles_cross). Sorted.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_pairs() const;
+
+  // The pairs (s, t), s < t, of non-degenerate triangles that cross where s or t is in `focus`
+  // (ascending triangle indices). Sorted, each pair once.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_pairs_involving(
+      std::span<const std::uint32_t> focus) const;
 
  private:
   struct Box {
@@ -113,66 +121,6 @@ void TriangleCells::for_each_near(const Vec3f& lo, const Vec3f& hi, Visit&& visi
   scan(small_, lo, hi, near);
   scan(large_, lo, hi, near);
   for (const std::uint32_t t : huge_) near(t);
-}
-
-template <class Skip, class Focus>
-std::vector<std::pair<std::uint32_t, std::uint32_t>> TriangleCells::crossing_pairs(
-    Skip&& skip, Focus&& focus) const {
-  using Pairs = std::vector<std::pair<std::uint32_t, std::uint32_t>>;
-  tbb::enumerable_thread_specific<Pairs> found;
-  // Small triangles: each cell against itself and its 13 neighbours on the forward side, so
-  // that every pair of cells is met once. Boxes are read in filing order (small_.boxes), so the
-  // pairs of two cells are tested from two short runs of memory.
-  const auto cell_pairs = [&](std::size_t slot, Pairs& pairs) {
-    const auto test = [&](std::uint32_t i, std::uint32_t j) {
-      if (!overlap(small_.boxes[i], small_.boxes[j])) return;
-      const std::uint32_t s = small_.filed[i], t = small_.filed[j];
-      if (degenerate_[s] || degenerate_[t] || skip(s) || skip(t) || !(focus(s) || focus(t))) return;
-      if (triangles_cross(points_, triangles_[s], triangles_[t])) {
-        pairs.push_back({std::min(s, t), std::max(s, t)});
-      }
-    };
-    const std::uint64_t k = small_.keys[slot];
-    for (std::uint32_t i = small_.begin[slot]; i < small_.end[slot]; ++i) {
-      for (std::uint32_t j = i + 1; j < small_.end[slot]; ++j) test(i, j);
-    }
-    const auto x = static_cast<std::int64_t>(k >> 42) - kBias;
-    const auto y = static_cast<std::int64_t>(k >> 21 & 0x1FFFFF) - kBias;
-    const auto z = static_cast<std::int64_t>(k & 0x1FFFFF) - kBias;
-    for (int d = 14; d < 27; ++d) {  // offsets (dx, dy, dz) after (0, 0, 0) in z-y-x order
-      const std::size_t other = small_.find(key(x + d % 3 - 1, y + d / 3 % 3 - 1, z + d / 9 - 1));
-      if (other == small_.keys.size()) continue;
-      for (std::uint32_t i = small_.begin[slot]; i < small_.end[slot]; ++i) {
-        for (std::uint32_t j = small_.begin[other]; j < small_.end[other]; ++j) test(i, j);
-      }
-    }
-  };
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, small_.keys.size(), 4096),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      Pairs& pairs = found.local();
-                      for (std::size_t slot = range.begin(); slot < range.end(); ++slot) {
-                        if (small_.keys[slot] != kEmpty) cell_pairs(slot, pairs);
-                      }
-                    });
-  Pairs pairs;
-  for (const Pairs& part : found) pairs.insert(pairs.end(), part.begin(), part.end());
-  // Larger triangles against everything near them (each pair of two larger ones once).
-  const auto against_all = [&](std::uint32_t t) {
-    for_each_near(boxes_[t].lo, boxes_[t].hi, [&](std::uint32_t other) {
-      if (other == t || (size_[other] != 0 && other < t)) return;
-      if (degenerate_[t] || degenerate_[other] || skip(t) || skip(other) ||
-          !(focus(t) || focus(other))) {
-        return;
-      }
-      if (triangles_cross(points_, triangles_[t], triangles_[other])) {
-        pairs.push_back({std::min(t, other), std::max(t, other)});
-      }
-    });
-  };
-  for (const std::uint32_t t : large_.filed) against_all(t);
-  for (const std::uint32_t t : huge_) against_all(t);
-  std::sort(pairs.begin(), pairs.end());
-  return pairs;
 }
 
 }  // namespace g2s::detail

@@ -6,9 +6,14 @@
 // neighbouring triangles consistently oriented.
 #include "grow/grower.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
+#include <span>
 
 #include "cleanup/cleanup.hpp"
 #include "common/edge_map.hpp"
@@ -280,7 +285,7 @@ class Grower {
   // (docs/algorithm.md, "No crossing triangles" and "Hole filling"). Filling first lets a hole
   // between two fans of a point join them, where deleting one fan would leave a larger hole.
   void finish_surface() {
-    compact(remove_crossings(detail::TriangleCells(grid_.points(), triangles_)));
+    compact(remove_crossings());
     if (options_.max_hole_edges < 3) return;
     fill_small_holes();
     // Points whose whole star is in this run: growable, and no corner of a triangle kept from
@@ -327,7 +332,7 @@ class Grower {
   // One round of hole filling (fill_holes) and the removal of fillings that cross each other.
   void fill_small_holes() {
     const auto grown = static_cast<std::uint32_t>(triangles_.size());
-    fill_holes(detail::TriangleCells(grid_.points(), triangles_));
+    fill_holes();
     std::vector<std::uint8_t> dead(triangles_.size(), 0);
     remove_crossing_fills(grown, dead);
     compact(std::move(dead));
@@ -335,11 +340,14 @@ class Grower {
 
   // Of every pair of crossing triangles, the one grown later is marked dead (fronts that met
   // between the layers of a noisy scan). Triangles loaded before the run are never removed.
-  // Corners of removed triangles become suspects of the non-manifold pass.
-  std::vector<std::uint8_t> remove_crossings(const detail::TriangleCells& cells) {
+  // Corners of removed triangles become suspects of the non-manifold pass. Only pairs with a
+  // triangle not in an empty ball can cross (detail::in_empty_ball).
+  std::vector<std::uint8_t> remove_crossings() {
     std::vector<std::uint8_t> dead(triangles_.size(), 0);
-    const auto pairs = cells.crossing_pairs([](std::uint32_t) { return false; },
-                                            [](std::uint32_t) { return true; });
+    const std::vector<std::uint32_t> focus = uncertified();
+    if (focus.empty()) return dead;
+    const auto pairs =
+        detail::TriangleCells(grid_.points(), triangles_).crossing_pairs_involving(focus);
     if (pairs.empty()) return dead;
     for (const auto& [first, second] : pairs) {
       if (dead[first] || dead[second]) continue;
@@ -356,6 +364,22 @@ class Grower {
     return dead;
   }
 
+  // The triangles not certified crossing-free by an empty ball through their corners, ascending.
+  std::vector<std::uint32_t> uncertified() const {
+    std::vector<std::uint8_t> empty(triangles_.size(), 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, triangles_.size(), 1024),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        for (std::size_t t = range.begin(); t < range.end(); ++t) {
+                          empty[t] = detail::in_empty_ball(grid_, triangles_[t]);
+                        }
+                      });
+    std::vector<std::uint32_t> rest;
+    for (std::uint32_t t = 0; t < triangles_.size(); ++t) {
+      if (!empty[t]) rest.push_back(t);
+    }
+    return rest;
+  }
+
   // The triangle as it will face once its group's orientation is applied.
   Triangle facing(std::uint32_t t) {
     Triangle tri = triangles_[t];
@@ -370,7 +394,8 @@ class Grower {
   // each edge in goes on by the first free edge out counter-clockwise from it (next_open_edges),
   // so the gap between two fans is a hole of its own, and filling it makes the two fans one.
   // Appends the filling triangles to triangles_.
-  void fill_holes(const detail::TriangleCells& cells) {
+  void fill_holes() {
+    std::optional<detail::TriangleCells> cells;  // of the grown triangles, once a loop needs them
     std::vector<OpenEdge> open;
     const auto grown = static_cast<std::uint32_t>(triangles_.size());
     for (std::uint32_t t = 0; t < grown; ++t) {
@@ -437,7 +462,8 @@ class Grower {
         return edges_.find(loop[i], loop[j]) == EdgeMap::kMissing;
       };
       if (!detail::triangulate_loop(grid_.points(), loop, chord_ok, scratch, fill)) continue;
-      if (!fill_fits(fill, cells)) continue;
+      if (!cells) cells.emplace(grid_.points(), std::span<const Triangle>(triangles_).first(grown));
+      if (!fill_fits(fill, *cells)) continue;
       // The triangles around face consistently along the loop: their groups become one, as
       // they face now.
       const std::uint32_t group = group_[open[h0].triangle];
@@ -608,9 +634,7 @@ class Grower {
     if (triangles_.size() == first_fill) return;
     const std::span<const Triangle> fills =
         std::span<const Triangle>(triangles_).subspan(first_fill);
-    const auto pairs = detail::TriangleCells(grid_.points(), fills)
-                           .crossing_pairs([](std::uint32_t) { return false; },
-                                           [](std::uint32_t) { return true; });
+    const auto pairs = detail::TriangleCells(grid_.points(), fills).crossing_pairs();
     for (const auto& [first, second] : pairs) {
       const std::uint32_t earlier = fill_loop_[first], later = fill_loop_[second];
       if (dead[earlier]) continue;

@@ -7,6 +7,8 @@
 
 #include <random>
 
+#include "grid/hash_grid.hpp"
+
 namespace g2s {
 namespace {
 
@@ -49,15 +51,16 @@ TEST(Crossings, CellsFindExactlyThePairsOfABruteForceSearch) {
     }
     ASSERT_GT(expected.size(), 50u) << "the soup must cross itself to test anything";
     const detail::TriangleCells cells(soup.points, soup.triangles);
-    const auto found = cells.crossing_pairs([](std::uint32_t) { return false; },
-                                            [](std::uint32_t) { return true; });
-    EXPECT_EQ(found, expected);
-    // Focus on one triangle: only its pairs.
-    const std::uint32_t focus = expected.front().first;
-    const auto focused = cells.crossing_pairs([](std::uint32_t) { return false; },
-                                              [&](std::uint32_t t) { return t == focus; });
-    for (const auto& [s, t] : focused) EXPECT_TRUE(s == focus || t == focus);
-    EXPECT_FALSE(focused.empty());
+    EXPECT_EQ(cells.crossing_pairs(), expected);
+    // Focused on some triangles: exactly the pairs that involve one of them.
+    std::vector<std::uint32_t> focus;
+    for (std::uint32_t t = 0; t < soup.triangles.size(); t += 5) focus.push_back(t);
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> involving;
+    for (const auto& [s, t] : expected) {
+      if (s % 5 == 0 || t % 5 == 0) involving.push_back({s, t});
+    }
+    ASSERT_FALSE(involving.empty());
+    EXPECT_EQ(cells.crossing_pairs_involving(focus), involving);
   }
 }
 
@@ -73,6 +76,65 @@ TEST(Crossings, SharedEdgesAndCornersAreNotCrossings) {
   const std::vector<Vec3f> pierce = {{0, 0, 0},        {1, 0, 0},       {1, 1, 0},
                                      {0.7f, 0.2f, -1}, {0.7f, 0.2f, 1}, {0.9f, 0.3f, 1}};
   EXPECT_TRUE(detail::triangles_cross(pierce, {0, 1, 2}, {3, 4, 5}));
+}
+
+TEST(Crossings, TrianglesInEmptyBallsNeverCrossEachOther) {
+  // Every triangle of nearby corners in a random cloud; those certified by an empty ball must
+  // be pairwise free of crossings, while the rest cross plenty.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> where(0, 1);
+  std::vector<float> xyz;
+  for (int i = 0; i < 3 * 120; ++i) xyz.push_back(where(rng));
+  const HashGrid grid(xyz, {});
+  std::vector<Triangle> triangles;
+  for (Index a = 0; a < grid.size(); ++a) {
+    for (Index b = a + 1; b < grid.size(); ++b) {
+      for (Index c = b + 1; c < grid.size(); ++c) {
+        const auto near = [&](Index u, Index v) {
+          return norm2(grid.position(u) - grid.position(v)) < 0.09;
+        };
+        if (near(a, b) && near(b, c) && near(a, c)) triangles.push_back({a, b, c});
+      }
+    }
+  }
+  std::vector<Triangle> certified;
+  for (const Triangle& t : triangles) {
+    if (detail::in_empty_ball(grid, t)) certified.push_back(t);
+  }
+  ASSERT_GT(certified.size(), 100u);
+  ASSERT_LT(certified.size(), triangles.size() / 2);
+  std::size_t crossings = 0;
+  for (std::size_t s = 0; s < triangles.size(); ++s) {
+    for (std::size_t t = s + 1; t < triangles.size(); ++t) {
+      crossings += detail::triangles_cross(grid.points(), triangles[s], triangles[t]);
+    }
+  }
+  EXPECT_GT(crossings, 100u);
+  for (std::size_t s = 0; s < certified.size(); ++s) {
+    for (std::size_t t = s + 1; t < certified.size(); ++t) {
+      EXPECT_FALSE(detail::triangles_cross(grid.points(), certified[s], certified[t]));
+    }
+  }
+}
+
+TEST(Crossings, AFourthPointOnTheSphereDeniesTheCertificate) {
+  // A square's corners lie on one circle: either diagonal's triangles could be Delaunay, and the
+  // two splits overlap, so no triangle of them may be certified. A point nudged off the circle
+  // decides it.
+  const std::vector<float> square = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+  const HashGrid on_circle(square, {});
+  for (const Triangle& t : {Triangle{0, 1, 2}, Triangle{0, 2, 3}, Triangle{0, 1, 3}}) {
+    EXPECT_FALSE(detail::in_empty_ball(on_circle, t));
+  }
+  std::vector<float> kite = square;
+  kite[10] = 1.01f;  // the fourth corner just outside the circle of the first three
+  const HashGrid off_circle(kite, {});
+  Index at[4];  // grid index of each input point
+  for (Index i = 0; i < 4; ++i) at[off_circle.source(i)] = i;
+  EXPECT_TRUE(detail::in_empty_ball(off_circle, {at[0], at[1], at[2]}));
+  EXPECT_TRUE(detail::in_empty_ball(off_circle, {at[0], at[2], at[3]}));
+  EXPECT_FALSE(detail::in_empty_ball(off_circle, {at[0], at[1], at[3]}));
+  EXPECT_FALSE(detail::in_empty_ball(off_circle, {at[1], at[2], at[3]}));
 }
 
 }  // namespace
