@@ -6,6 +6,7 @@
 // boundary, so the halo a neighbour needs is a prefix of the block.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -51,6 +52,14 @@ struct TileStoreOptions {
   // Called now and then with (points done, points in total) while writing; may be empty.
   std::function<void(std::uint64_t, std::uint64_t)> progress;
 };
+
+// The largest tile for a cloud of `total` points under `options` (tile_points, lowered to
+// total / min_tiles but not below min_tile_points).
+inline std::uint64_t largest_tile_points(const TileStoreOptions& options, std::uint64_t total) {
+  if (options.min_tiles <= 1) return options.tile_points;
+  const std::uint64_t share = (total + options.min_tiles - 1) / options.min_tiles;
+  return std::min(options.tile_points, std::max(share, options.min_tile_points));
+}
 
 struct TileStoreReport {
   ReadReport read;  // what the input reader saw (format, finite and non-finite points)

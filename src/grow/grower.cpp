@@ -407,17 +407,13 @@ class Grower {
     }
     const std::vector<std::uint32_t> next = next_open_edges(open);
     const std::size_t max_edges = static_cast<std::size_t>(options_.max_hole_edges);
-    std::vector<std::uint8_t> taken(open.size(), 0);
-    std::vector<std::uint32_t> on_loop(grid_.size(), kNoIndex);  // the loop a point is on
-    std::vector<Index> loop;
-    std::vector<Triangle> fill;
-    detail::HoleScratch scratch;
-    // The loops first: per loop its first edge, its length, whether it is simple (no point
-    // twice, every point growable), and its component (the surface piece it borders).
+    // The loops first, as runs of open edges (loop_edges[begin, begin + length)), each with its
+    // component (the surface piece it borders) and whether it can be filled (every point
+    // fillable, the loop closed). A loop that passes a point twice is split there into loops
+    // that do not (two holes touching at a corner are two holes).
     struct Loop {
-      std::uint32_t first, length;
-      bool simple;
-      std::uint32_t component;
+      std::uint32_t begin, length, component;
+      bool closable;
     };
     std::vector<std::uint32_t> piece(grid_.size());
     for (std::uint32_t v = 0; v < grid_.size(); ++v) piece[v] = v;
@@ -428,49 +424,77 @@ class Grower {
       piece[find_root(piece, tri[2])] = r0;
     }
     std::vector<Loop> loops;
+    std::vector<std::uint32_t> loop_edges, trace;
+    std::vector<std::uint8_t> taken(open.size(), 0);
+    std::vector<std::uint32_t> at(grid_.size(), kNoIndex);  // a point's place in `trace`
+    const auto close_loop = [&](std::size_t from, bool closed) {
+      Loop l{static_cast<std::uint32_t>(loop_edges.size()),
+             static_cast<std::uint32_t>(trace.size() - from),
+             find_root(piece, open[trace[from]].from), closed};
+      for (std::size_t k = from; k < trace.size(); ++k) {
+        const Index v = open[trace[k]].from;
+        l.closable = l.closable && fillable(v);
+        at[v] = kNoIndex;
+        loop_edges.push_back(trace[k]);
+      }
+      trace.resize(from);
+      loops.push_back(l);
+    };
     for (std::uint32_t h0 = 0; h0 < open.size(); ++h0) {
       if (taken[h0]) continue;
-      Loop l{h0, 0, true, find_root(piece, open[h0].from)};
       std::uint32_t h = h0;
+      bool closed = true;
       do {
         taken[h] = 1;
         const Index v = open[h].from;
-        l.simple = l.simple && on_loop[v] != h0 && fillable(v) && next[h] != h;
-        on_loop[v] = h0;
-        ++l.length;
+        if (at[v] != kNoIndex) close_loop(at[v], true);
+        at[v] = static_cast<std::uint32_t>(trace.size());
+        trace.push_back(h);
+        closed = closed && next[h] != h;
         h = next[h] == h ? h0 : next[h];  // an unpaired edge ends its loop
       } while (h != h0);
-      loops.push_back(l);
+      close_loop(0, closed);
     }
     // A piece's longest loop is its outer border, not a hole: filling it would close a patch
     // into a shell.
     std::vector<std::uint32_t> longest(grid_.size(), 0);
     for (const Loop& l : loops) longest[l.component] = std::max(longest[l.component], l.length);
+    std::vector<Index> loop;
+    std::vector<Vec3> around;
+    std::vector<Triangle> fill;
+    detail::HoleScratch scratch;
     for (const Loop& l : loops) {
-      if (!l.simple || l.length < 3 || l.length > max_edges) continue;
+      if (!l.closable || l.length < 3 || l.length > max_edges) continue;
       if (l.length == longest[l.component]) continue;
+      const std::span<const std::uint32_t> edges(loop_edges.data() + l.begin, l.length);
       loop.clear();
-      for (std::uint32_t h = l.first, k = 0; k < l.length; ++k, h = next[h]) {
-        loop.push_back(open[h].from);
+      around.clear();
+      for (const std::uint32_t e : edges) {
+        loop.push_back(open[e].from);
+        around.push_back(facing_normal(open[e].triangle));
       }
-      const std::uint32_t h0 = l.first;
-      std::uint32_t h = h0;
-      // The filling traverses each loop edge the other way: the loop reversed.
+      // The filling traverses each loop edge the other way: the loop reversed, so that edge i
+      // of the reversed loop is edge n-2-i of the loop, and the closing edge stays last.
       std::reverse(loop.begin(), loop.end());
+      std::reverse(around.begin(), around.end() - 1);
       fill.clear();
       const auto chord_ok = [&](std::size_t i, std::size_t j) {
         return edges_.find(loop[i], loop[j]) == EdgeMap::kMissing;
       };
-      if (!detail::triangulate_loop(grid_.points(), loop, chord_ok, scratch, fill)) continue;
       if (!cells) cells.emplace(grid_.points(), std::span<const Triangle>(triangles_).first(grown));
-      if (!fill_fits(fill, *cells)) continue;
+      const auto triangle_ok = [&](std::size_t i, std::size_t k, std::size_t j) {
+        return fill_fits({loop[i], loop[k], loop[j]}, *cells);
+      };
+      if (!detail::triangulate_loop(grid_.points(), loop, around, chord_ok, triangle_ok, scratch,
+                                    fill)) {
+        continue;
+      }
       // The triangles around face consistently along the loop: their groups become one, as
       // they face now.
-      const std::uint32_t group = group_[open[h0].triangle];
-      do {
-        groups_.unite(groups_.find(group).first, groups_.find(group_[open[h].triangle]).first, 0);
-        h = next[h];
-      } while (h != h0);
+      const std::uint32_t group = group_[open[edges.front()].triangle];
+      for (const std::uint32_t e : edges) {
+        groups_.unite(groups_.find(group).first, groups_.find(group_[open[e].triangle]).first, 0);
+      }
       const std::uint8_t flip = groups_.find(group).second;
       const auto first = static_cast<std::uint32_t>(triangles_.size());
       for (const Triangle& t : fill) {
@@ -573,58 +597,37 @@ class Grower {
     return normalized(cross(grid_.position(tri[1]) - a, grid_.position(tri[2]) - a));
   }
 
-  // Whether the triangles filling one hole keep within the fold limit of each other and of the
-  // triangles around the hole (`owner`: per point, the triangle on its open edge out), and
-  // cross no live triangle of the mesh.
-  bool fill_fits(std::span<const Triangle> fill, const detail::TriangleCells& cells) {
-    const auto normal = [&](const Triangle& t) {
-      const Vec3 a = grid_.position(t[0]);
-      return normalized(cross(grid_.position(t[1]) - a, grid_.position(t[2]) - a));
-    };
-    for (std::size_t i = 0; i < fill.size(); ++i) {
-      const Triangle& t = fill[i];
-      const Vec3 n = normal(t);
-      for (int k = 0; k < 3; ++k) {
-        const Index u = t[k], v = t[(k + 1) % 3];
-        // Across a loop edge: the triangle around the hole on edge u-v.
-        const std::uint32_t around = edges_.find(u, v);
-        if (around != EdgeMap::kMissing && !(around & EdgeMap::kClosed) &&
-            dot(n, normal(facing(around))) < cos_max_fold_) {
-          return false;
-        }
-        // Across a chord: another filling triangle.
-        for (std::size_t j = i + 1; j < fill.size(); ++j) {
-          if (traverses(fill[j], v, u) && dot(n, normal(fill[j])) < cos_max_fold_) return false;
-        }
-      }
-      const Vec3f& p0 = grid_.point(t[0]);
-      const Vec3f& p1 = grid_.point(t[1]);
-      const Vec3f& p2 = grid_.point(t[2]);
-      const Vec3f lo{std::min({p0.x, p1.x, p2.x}), std::min({p0.y, p1.y, p2.y}),
-                     std::min({p0.z, p1.z, p2.z})};
-      const Vec3f hi{std::max({p0.x, p1.x, p2.x}), std::max({p0.y, p1.y, p2.y}),
-                     std::max({p0.z, p1.z, p2.z})};
-      // Points this run may not use (a seam's context: tiles still to come) must not lie in
-      // the triangle's smallest ball: the surface may yet be meshed over them.
-      Ball ball;
-      if (!circumball(grid_.position(t[0]), grid_.position(t[1]), grid_.position(t[2]), ball)) {
-        return false;
-      }
-      if (!growable_.empty()) {
-        bool covers_context = false;
-        grid_.for_each_in_ball(ball.centre, std::sqrt(ball.radius2), [&](std::uint32_t j, double) {
-          covers_context = covers_context || !growable(j);
-        });
-        if (covers_context) return false;
-      }
-      bool crosses = false;
-      cells.for_each_near(lo, hi, [&](std::uint32_t other) {
-        crosses = crosses || (!cells.degenerate(other) &&
-                              detail::triangles_cross(grid_.points(), t, triangles_[other]));
-      });
-      if (crosses) return false;
+  // Whether a triangle filling a hole stays clear of the context points, crosses no live
+  // triangle of the mesh and repeats none (the loop around a lone triangle that touches the rest
+  // at a corner is a loop of its own).
+  bool fill_fits(const Triangle& t, const detail::TriangleCells& cells) {
+    const Vec3f& p0 = grid_.point(t[0]);
+    const Vec3f& p1 = grid_.point(t[1]);
+    const Vec3f& p2 = grid_.point(t[2]);
+    const Vec3f lo{std::min({p0.x, p1.x, p2.x}), std::min({p0.y, p1.y, p2.y}),
+                   std::min({p0.z, p1.z, p2.z})};
+    const Vec3f hi{std::max({p0.x, p1.x, p2.x}), std::max({p0.y, p1.y, p2.y}),
+                   std::max({p0.z, p1.z, p2.z})};
+    // Points this run may not use (a seam's context: tiles still to come) must not lie in
+    // the triangle's smallest ball: the surface may yet be meshed over them.
+    Ball ball;
+    if (!circumball(grid_.position(t[0]), grid_.position(t[1]), grid_.position(t[2]), ball)) {
+      return false;
     }
-    return true;
+    if (!growable_.empty()) {
+      bool covers_context = false;
+      grid_.for_each_in_ball(ball.centre, std::sqrt(ball.radius2), [&](std::uint32_t j, double) {
+        covers_context = covers_context || !growable(j);
+      });
+      if (covers_context) return false;
+    }
+    bool crosses = false;
+    cells.for_each_near(lo, hi, [&](std::uint32_t other) {
+      const Triangle& o = triangles_[other];
+      crosses = crosses || std::is_permutation(o.begin(), o.end(), t.begin()) ||
+                (!cells.degenerate(other) && detail::triangles_cross(grid_.points(), t, o));
+    });
+    return !crosses;
   }
 
   // Fillings of neighbouring holes may cross each other: the later filling of each crossing

@@ -1,9 +1,14 @@
-// Triangulating a hole: the least-area triangulation of a closed boundary loop over its own
-// points (no new vertex, so the mesh still interpolates the cloud). The grower fills small
-// holes with it once growth is over (docs/algorithm.md, "Hole filling").
+// Triangulating a hole over the boundary loop's own points (no new vertex, so the mesh still
+// interpolates the cloud). Of all triangulations, one whose sharpest fold (between two of its
+// triangles, or between one of them and the mesh around the loop) is the gentlest, with a small
+// area among those: the least-area triangulation alone folds a bent loop's filling back over
+// itself, and the grower would then refuse it. The grower fills small holes with it once growth is
+// over (docs/algorithm.md, "Hole filling").
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -14,8 +19,16 @@ namespace g2s::detail {
 
 // Working arrays of triangulate_loop, kept between calls so that filling allocates once.
 struct HoleScratch {
-  std::vector<double> cost;
-  std::vector<std::uint16_t> split;
+  // The best filling of the polygon loop[i..j] closed by chord i-j whose triangle on the chord
+  // is (i, k, j): state (i, j, k).
+  struct State {
+    double fold_cos;  // the cosine of the sharpest fold inside (larger is gentler)
+    double area;
+    Vec3 normal;          // of triangle (i, k, j)
+    std::uint16_t left;   // the apex on chord i-k (k == i + 1: a loop edge, none)
+    std::uint16_t right;  // the apex on chord k-j
+  };
+  std::vector<State> states;
   std::vector<std::size_t> stack;
 };
 
@@ -24,58 +37,99 @@ inline double triangle_area(const Vec3f& a, const Vec3f& b, const Vec3f& c) {
 }
 
 // Inputs: points; loop, the hole's corners in the order the filling triangles traverse them
-// (each filling triangle is counter-clockwise along it; at most 65,535 corners); chord_ok(i, j),
-// for loop positions i < j that are not neighbours on the loop, whether the edge
-// loop[i]-loop[j] may be made (false where the mesh has that edge already); scratch space.
-// Output: appends loop.size() - 2 triangles to `out` and returns true, or returns false (out
-// unchanged) when every triangulation needs a forbidden chord or a degenerate triangle.
-template <class ChordOk>
-bool triangulate_loop(std::span<const Vec3f> points, std::span<const Index> loop,
-                      ChordOk&& chord_ok, HoleScratch& scratch, std::vector<Triangle>& out) {
+// (each filling triangle is counter-clockwise along it; at most 65,535 corners); around[i], the
+// unit normal of the mesh triangle across loop edge loop[i]-loop[i+1] (i = n-1: across
+// loop[n-1]-loop[0]), facing as the filling will; chord_ok(i, j), for loop positions i < j that
+// are not neighbours on the loop, whether the edge loop[i]-loop[j] may be made (false where the
+// mesh has that edge already); triangle_ok(i, k, j), whether the triangle on loop positions
+// i < k < j may be made (asked once per triangle, after the cheaper conditions); scratch space.
+// Output: appends loop.size() - 2 triangles to `out` and returns the cosine of their sharpest
+// fold (between two of them or with `around`), or returns nothing (out unchanged) when every
+// triangulation needs a forbidden chord, a forbidden triangle or a degenerate one. The sharpest
+// fold is the gentlest any triangulation has (exact); among those, the area is made small
+// greedily.
+// O(n^4) time, O(n^3) scratch: loops are short (the grower's limit is max_hole_edges).
+template <class ChordOk, class TriangleOk>
+std::optional<double> triangulate_loop(std::span<const Vec3f> points, std::span<const Index> loop,
+                                       std::span<const Vec3> around, ChordOk&& chord_ok,
+                                       TriangleOk&& triangle_ok, HoleScratch& scratch,
+                                       std::vector<Triangle>& out) {
   const std::size_t n = loop.size();
-  if (n < 3) return false;
-  constexpr double kNone = 1e300;
-  // cost[i*n + j]: least area of the polygon loop[i..j] closed by chord i-j (Barequet & Sharir's
-  // dynamic programme, O(n^3)); split: the apex k of the triangle on chord i-j.
-  scratch.cost.assign(n * n, kNone);
-  scratch.split.assign(n * n, 0);
-  for (std::size_t i = 0; i + 1 < n; ++i) scratch.cost[i * n + i + 1] = 0;
+  constexpr double kNone = -2;  // below every cosine
+  if (n < 3 || around.size() != n) return std::nullopt;
+  using State = HoleScratch::State;
+  scratch.states.assign(n * n * n, State{kNone, 0, Vec3{0, 0, 0}, 0, 0});
+  const auto state = [&](std::size_t i, std::size_t j, std::size_t k) -> State& {
+    return scratch.states[(i * n + j) * n + k];
+  };
+  const auto better = [](double fold_cos, double area, double best_cos, double best_area) {
+    return fold_cos > best_cos || (fold_cos == best_cos && area < best_area);
+  };
+  // The best side of triangle (i, k, j) with normal `normal` on chord a-b (a loop edge when
+  // b == a + 1): its fold with that triangle included.
+  struct Side {
+    double fold_cos, area;
+    std::uint16_t apex;
+  };
+  const auto side = [&](std::size_t a, std::size_t b, const Vec3& normal) {
+    if (b == a + 1) return Side{dot(normal, around[a]), 0, 0};
+    Side best{kNone, 0, 0};
+    for (std::size_t c = a + 1; c < b; ++c) {
+      const State& s = state(a, b, c);
+      if (s.fold_cos == kNone) continue;
+      const double fold_cos = std::min(s.fold_cos, dot(normal, s.normal));
+      if (better(fold_cos, s.area, best.fold_cos, best.area)) {
+        best = Side{fold_cos, s.area, static_cast<std::uint16_t>(c)};
+      }
+    }
+    return best;
+  };
   for (std::size_t width = 2; width < n; ++width) {
     for (std::size_t i = 0; i + width < n; ++i) {
       const std::size_t j = i + width;
       // The chord i-j is a loop edge only for (0, n-1).
       if (!(i == 0 && j == n - 1) && !chord_ok(i, j)) continue;
-      double best = kNone;
-      std::uint16_t best_k = 0;
       for (std::size_t k = i + 1; k < j; ++k) {
-        const double left = scratch.cost[i * n + k], right = scratch.cost[k * n + j];
-        if (left >= kNone || right >= kNone) continue;
-        const double area = triangle_area(points[loop[i]], points[loop[k]], points[loop[j]]);
-        if (!(area > 0)) continue;
-        if (left + right + area < best) {
-          best = left + right + area;
-          best_k = static_cast<std::uint16_t>(k);
-        }
+        const Vec3 p = Vec3(points[loop[i]]);
+        const Vec3 w = cross(Vec3(points[loop[k]]) - p, Vec3(points[loop[j]]) - p);
+        const double twice_area = norm(w);
+        if (!(twice_area > 0)) continue;
+        const Vec3 normal = w * (1 / twice_area);
+        const Side left = side(i, k, normal), right = side(k, j, normal);
+        if (left.fold_cos == kNone || right.fold_cos == kNone || !triangle_ok(i, k, j)) continue;
+        state(i, j, k) =
+            State{std::min(left.fold_cos, right.fold_cos),
+                  left.area + right.area + 0.5 * twice_area, normal, left.apex, right.apex};
       }
-      scratch.cost[i * n + j] = best;
-      scratch.split[i * n + j] = best_k;
     }
   }
-  if (scratch.cost[n - 1] >= kNone) return false;
-  // Unwind the splits: (i, k, j) is counter-clockwise along the loop's order.
+  // The whole loop: chord 0-(n-1) is the closing loop edge.
+  double best_cos = kNone, best_area = 0;
+  std::size_t top = 0;
+  for (std::size_t k = 1; k + 1 < n; ++k) {
+    const State& s = state(0, n - 1, k);
+    if (s.fold_cos == kNone) continue;
+    const double fold_cos = std::min(s.fold_cos, dot(s.normal, around[n - 1]));
+    if (better(fold_cos, s.area, best_cos, best_area))
+      best_cos = fold_cos, best_area = s.area, top = k;
+  }
+  if (best_cos == kNone) return std::nullopt;
+  // Unwind the apexes: (i, k, j) is counter-clockwise along the loop's order.
   std::vector<std::size_t>& stack = scratch.stack;
-  stack.assign({0, n - 1});
+  stack.assign({0, n - 1, top});
   while (!stack.empty()) {
+    const std::size_t k = stack.back();
+    stack.pop_back();
     const std::size_t j = stack.back();
     stack.pop_back();
     const std::size_t i = stack.back();
     stack.pop_back();
-    if (j - i < 2) continue;
-    const std::size_t k = scratch.split[i * n + j];
     out.push_back({loop[i], loop[k], loop[j]});
-    stack.insert(stack.end(), {i, k, k, j});
+    const State& s = state(i, j, k);
+    if (k > i + 1) stack.insert(stack.end(), {i, k, s.left});
+    if (j > k + 1) stack.insert(stack.end(), {k, j, s.right});
   }
-  return true;
+  return best_cos;
 }
 
 }  // namespace g2s::detail

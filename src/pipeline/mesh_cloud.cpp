@@ -1,15 +1,21 @@
 // A cloud already in memory, meshed the way `g2s mesh` meshes a file: cut into tiles in memory
-// (MemoryTiles, the tile store's split) of the size the CLI's memory plan chooses, then grown,
-// stitched and cleaned by mesh_tiles. Tests, benchmarks and library users thus run the code the
-// CLI runs; a cloud smaller than a tile is one tile with nothing to stitch.
+// (MemoryTiles, the tile store's split) of the size the CLI chooses (its memory plan, and at
+// least the plan's minimum number of tiles), then grown, stitched and cleaned by mesh_tiles.
+// Tests, benchmarks and library users thus run the code the CLI runs; a cloud smaller than a
+// tile is one tile with nothing to stitch.
 #include "g2s/pipeline.hpp"
 
 namespace g2s {
 
 PipelineMesh mesh_cloud(const PointCloud& cloud, const PipelineOptions& options,
                         std::uint64_t tile_points) {
-  if (tile_points == 0)
-    tile_points = plan_memory(default_memory_budget(), options.threads).tile_points;
+  if (tile_points == 0) {
+    const MemoryPlan plan = plan_memory(default_memory_budget(), options.threads);
+    TileStoreOptions tiling;
+    tiling.tile_points = plan.tile_points;
+    tiling.min_tiles = plan.min_tiles;
+    tile_points = largest_tile_points(tiling, cloud.size());
+  }
   const MemoryTiles tiles(cloud, tile_points);
   return mesh_tiles(tiles, options);
 }

@@ -300,11 +300,7 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
   const std::uint64_t total = first.points;
   if (options.progress) options.progress(0, total);
 
-  std::uint64_t tile_points = options.tile_points;
-  if (options.min_tiles > 1) {
-    const std::uint64_t share = (total + options.min_tiles - 1) / options.min_tiles;
-    tile_points = std::min(tile_points, std::max(share, options.min_tile_points));
-  }
+  const std::uint64_t tile_points = largest_tile_points(options, total);
   TileTree tree(bounds);
   std::vector<std::uint64_t> counts;
   std::vector<std::uint32_t> leaves;

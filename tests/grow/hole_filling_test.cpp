@@ -1,13 +1,16 @@
-// The least-area triangulation of a hole's loop (src/grow/hole_filling.hpp) on loops whose
-// answers are known: a planar convex loop gives n - 2 triangles covering exactly its area, all
-// facing one way; forbidden chords are never used; a loop that can only be closed with
-// forbidden chords, or only with degenerate triangles, is left open.
+// The triangulation of a hole's loop (src/grow/hole_filling.hpp) on loops whose answers are
+// known: a planar convex loop gives n - 2 triangles covering exactly its area, all facing one
+// way; on bent loops its sharpest fold is the gentlest of all triangulations', as an
+// exhaustive search finds it; forbidden chords are never used; a loop that can only be closed
+// with forbidden chords, or only with degenerate triangles, is left open.
 #include "grow/hole_filling.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <random>
 
 namespace g2s {
 namespace {
@@ -20,6 +23,13 @@ std::vector<Vec3f> regular_polygon(int n) {
   }
   return points;
 }
+
+// The mesh around a flat loop in the plane z = 0, facing +z.
+std::vector<Vec3> flat_around(std::size_t n) {
+  return std::vector<Vec3>(n, Vec3{0, 0, 1});
+}
+
+const auto any_triangle = [](std::size_t, std::size_t, std::size_t) { return true; };
 
 std::vector<Index> identity_loop(int n) {
   std::vector<Index> loop(static_cast<std::size_t>(n));
@@ -34,7 +44,8 @@ TEST(HoleFilling, ConvexLoopIsCoveredOnceFacingOneWay) {
     detail::HoleScratch scratch;
     std::vector<Triangle> out;
     ASSERT_TRUE(detail::triangulate_loop(
-        points, loop, [](std::size_t, std::size_t) { return true; }, scratch, out));
+        points, loop, flat_around(loop.size()), [](std::size_t, std::size_t) { return true; },
+        any_triangle, scratch, out));
     ASSERT_EQ(out.size(), static_cast<std::size_t>(n - 2));
     double area = 0;
     for (const Triangle& t : out) {
@@ -55,10 +66,38 @@ TEST(HoleFilling, ForbiddenChordsAreNeverUsed) {
   const auto from_zero = [](std::size_t i, std::size_t) { return i == 0; };
   detail::HoleScratch scratch;
   std::vector<Triangle> out;
-  ASSERT_TRUE(detail::triangulate_loop(points, loop, from_zero, scratch, out));
+  ASSERT_TRUE(detail::triangulate_loop(points, loop, flat_around(8), from_zero, any_triangle,
+                                       scratch, out));
   for (const Triangle& t : out) {
     EXPECT_EQ(t[0], 0u) << "every triangle of the fan has corner 0 first";
   }
+}
+
+TEST(HoleFilling, ForbiddenTrianglesAreAvoidedOrTheLoopStaysOpen) {
+  const std::vector<Vec3f> points = regular_polygon(4);
+  const std::vector<Index> loop = identity_loop(4);
+  const auto all_chords = [](std::size_t, std::size_t) { return true; };
+  detail::HoleScratch scratch;
+  std::vector<Triangle> out;
+  // Without triangle 0-1-2 the square can only be split along 1-3.
+  const auto not_012 = [](std::size_t i, std::size_t k, std::size_t j) {
+    return !(i == 0 && k == 1 && j == 2);
+  };
+  ASSERT_TRUE(
+      detail::triangulate_loop(points, loop, flat_around(4), all_chords, not_012, scratch, out));
+  ASSERT_EQ(out.size(), 2u);
+  for (const Triangle& t : out) {
+    EXPECT_TRUE(std::find(t.begin(), t.end(), 1u) != t.end() &&
+                std::find(t.begin(), t.end(), 3u) != t.end());
+  }
+  // Without 0-1-2 and 0-1-3 no split is left.
+  out.clear();
+  const auto neither = [](std::size_t i, std::size_t k, std::size_t) {
+    return !(i == 0 && k == 1);
+  };
+  EXPECT_FALSE(
+      detail::triangulate_loop(points, loop, flat_around(4), all_chords, neither, scratch, out));
+  EXPECT_TRUE(out.empty());
 }
 
 TEST(HoleFilling, LoopThatNeedsAForbiddenChordStaysOpen) {
@@ -67,7 +106,8 @@ TEST(HoleFilling, LoopThatNeedsAForbiddenChordStaysOpen) {
   detail::HoleScratch scratch;
   std::vector<Triangle> out;
   EXPECT_FALSE(detail::triangulate_loop(
-      points, loop, [](std::size_t, std::size_t) { return false; }, scratch, out));
+      points, loop, flat_around(4), [](std::size_t, std::size_t) { return false; }, any_triangle,
+      scratch, out));
   EXPECT_TRUE(out.empty());
 }
 
@@ -77,7 +117,94 @@ TEST(HoleFilling, CollinearLoopStaysOpen) {
   detail::HoleScratch scratch;
   std::vector<Triangle> out;
   EXPECT_FALSE(detail::triangulate_loop(
-      points, loop, [](std::size_t, std::size_t) { return true; }, scratch, out));
+      points, loop, flat_around(4), [](std::size_t, std::size_t) { return true; }, any_triangle,
+      scratch, out));
+}
+
+// Every triangulation of loop positions [i, j] closed by chord i-j, as lists of triangles.
+void all_triangulations(std::size_t i, std::size_t j, std::vector<std::vector<Triangle>>& out) {
+  out.clear();
+  if (j - i < 2) {
+    out.push_back({});
+    return;
+  }
+  for (std::size_t k = i + 1; k < j; ++k) {
+    std::vector<std::vector<Triangle>> left, right;
+    all_triangulations(i, k, left);
+    all_triangulations(k, j, right);
+    for (const auto& l : left) {
+      for (const auto& r : right) {
+        std::vector<Triangle> t = l;
+        t.insert(t.end(), r.begin(), r.end());
+        t.push_back({static_cast<Index>(i), static_cast<Index>(k), static_cast<Index>(j)});
+        out.push_back(std::move(t));
+      }
+    }
+  }
+}
+
+TEST(HoleFilling, BentLoopsGetTheGentlestFillingAsAnExhaustiveSearchFindsIt) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> jitter(-0.4f, 0.4f);
+  for (int trial = 0; trial < 40; ++trial) {
+    const int n = 4 + trial % 4;
+    // A loop around the z axis, its corners pushed up and down, and tilted mesh around it.
+    std::vector<Vec3f> points = regular_polygon(n);
+    for (Vec3f& p : points) p.z = 2 * jitter(rng);
+    std::vector<Vec3> around;
+    for (int k = 0; k < n; ++k) around.push_back(normalized(Vec3{jitter(rng), jitter(rng), 1}));
+    const std::vector<Index> loop = identity_loop(n);
+    const auto normal = [&](const Triangle& t) {
+      const Vec3 a(points[t[0]]);
+      return normalized(cross(Vec3(points[t[1]]) - a, Vec3(points[t[2]]) - a));
+    };
+    // The sharpest fold of a triangulation: across every edge two triangles (or one and the
+    // mesh around) share.
+    const auto judge = [&](const std::vector<Triangle>& fill, double& area) {
+      double fold_cos = 1;
+      area = 0;
+      for (const Triangle& t : fill) {
+        area += detail::triangle_area(points[t[0]], points[t[1]], points[t[2]]);
+        for (int e = 0; e < 3; ++e) {
+          const Index u = t[e], v = t[(e + 1) % 3];
+          const auto un = static_cast<Index>(n);
+          if ((u + 1) % un == v) fold_cos = std::min(fold_cos, dot(normal(t), around[u]));
+          for (const Triangle& o : fill) {
+            for (int f = 0; f < 3; ++f) {
+              if (o[f] == v && o[(f + 1) % 3] == u) {
+                fold_cos = std::min(fold_cos, dot(normal(t), normal(o)));
+              }
+            }
+          }
+        }
+      }
+      return fold_cos;
+    };
+    std::vector<std::vector<Triangle>> every;
+    all_triangulations(0, static_cast<std::size_t>(n - 1), every);
+    double best_cos = -2;
+    for (const auto& fill : every) {
+      double area = 0;
+      best_cos = std::max(best_cos, judge(fill, area));
+    }
+    double worst_area_at_best = 0;  // the area is chosen greedily: within those of the best
+    for (const auto& fill : every) {
+      double area = 0;
+      if (judge(fill, area) >= best_cos - 1e-12) {
+        worst_area_at_best = std::max(worst_area_at_best, area + 1e-9);
+      }
+    }
+    detail::HoleScratch scratch;
+    std::vector<Triangle> out;
+    const auto fold_cos = detail::triangulate_loop(
+        points, loop, around, [](std::size_t, std::size_t) { return true; }, any_triangle, scratch,
+        out);
+    ASSERT_TRUE(fold_cos);
+    double area = 0;
+    EXPECT_NEAR(judge(out, area), best_cos, 1e-9) << "trial " << trial;
+    EXPECT_NEAR(*fold_cos, best_cos, 1e-9) << "trial " << trial;
+    EXPECT_LE(area, worst_area_at_best) << "trial " << trial;
+  }
 }
 
 }  // namespace
