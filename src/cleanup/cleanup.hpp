@@ -1,5 +1,5 @@
 // Post-processing of a grown mesh: non-manifold vertex removal (docs/algorithm.md §5) and the
-// orientation of each component.
+// orientation of each component, both as the pipeline applies them while the mesh is built.
 #pragma once
 
 #include <array>
@@ -20,45 +20,20 @@ struct NonManifoldReport {
   std::uint64_t vertices_unjudged = 0;
 };
 
-// Deletes triangles until every vertex's triangles form a single fan: of a vertex's fans it keeps
-// the closed one (type I) or the largest (type II). Triangles must have no non-manifold edge.
-// Removed triangles are erased from `triangles`; the order of the rest is kept.
-NonManifoldReport remove_non_manifold_vertices(std::vector<Triangle>& triangles,
-                                               std::size_t vertex_count);
-
-// The same, when only `suspects` can have more than one fan (the grower knows where it started a
-// second fan): vertices are examined only there and where deletions split fans.
-NonManifoldReport remove_non_manifold_vertices_at(std::vector<Triangle>& triangles,
-                                                  std::size_t vertex_count,
-                                                  std::span<const Index> suspects);
-
-// The same on a mesh still being built (the stitcher's live triangles): triangles to delete are
-// marked in `dead` (one flag per triangle, set to 1) rather than erased, and only vertices whose
-// star is complete and whole (finished[v] == 1) are judged; a deletion that may split the fan
-// of an unfinished vertex (0) puts that vertex in `deferred`, to be judged when it is finished,
-// and one of a vertex whose star is no longer whole (2) is counted as unjudged. An empty
-// `finished` means every vertex is judged.
+// Of each vertex's fans (its triangles linked across the edges they share at it) keeps one, the
+// closed one (type I) or the largest (type II), and marks the others' triangles for deletion in
+// `dead` (one flag per triangle, set to 1); triangles must have no non-manifold edge. It works on
+// a mesh still being built (the grower's, a tile's, the stitcher's live triangles): only
+// `suspects` (where the grower started a second fan) and the vertices a deletion may split are
+// examined, and of those only vertices whose star is complete and whole (finished[v] == 1) are
+// judged; a deletion that may split the fan of an unfinished vertex (0) puts that vertex in
+// `deferred`, to be judged when it is finished, and one of a vertex whose star is no longer
+// whole (2) is counted as unjudged. An empty `finished` means every vertex is judged.
 NonManifoldReport mark_non_manifold_fans(std::span<const Triangle> triangles,
                                          std::size_t vertex_count, std::span<const Index> suspects,
                                          std::span<const std::uint8_t> finished,
                                          std::vector<std::uint8_t>& dead,
                                          std::vector<Index>& deferred);
-
-// Edges used by exactly one triangle, as that triangle traverses them.
-std::vector<std::array<Index, 2>> open_edges(const std::vector<Triangle>& triangles,
-                                             std::size_t vertex_count);
-
-// Flips whole components so that closed ones face outward (positive signed volume), and open
-// ones whose mean normal is mostly vertical face up (+z, aerial scans), the others away from
-// their centroid. Triangles must be consistently oriented within a component and have no
-// non-manifold vertex (so components joined at a vertex are joined along edges too).
-// `open`: the mesh's open edges (open_edges()), reversed where their component is flipped.
-// Returns the number of components flipped.
-std::uint64_t orient_components(std::vector<Triangle>& triangles, std::span<const Vec3f> positions,
-                                std::vector<std::array<Index, 2>>& open);
-
-// The same, telling closed components from open ones without an edge map (an XOR of edge keys).
-std::uint64_t orient_components(std::vector<Triangle>& triangles, std::span<const Vec3f> positions);
 
 // Per orientation group, sums over its triangles as stored (not yet flipped), enough to orient
 // the component at the end without the triangles: with positions taken from a fixed origin, a
@@ -73,7 +48,9 @@ struct GroupSums {
 
 // The flips that orient a mesh given as orientation groups: flip[g] reverses group g. Groups
 // joined in `groups` form one component; its parity makes it consistent, and with `orient` the
-// component then faces as orient_components() would have it. Counts the components reversed.
+// component then faces outward if closed (positive signed volume about its centroid), up (+z)
+// if open with a mean normal mostly vertical (aerial scans), else away from its centroid.
+// Counts the components reversed.
 std::vector<std::uint8_t> group_flips(ParityUnionFind& groups, std::span<const GroupSums> sums,
                                       bool orient, std::uint64_t& flipped);
 

@@ -12,13 +12,6 @@
 #include "common/union_find.hpp"
 
 namespace g2s {
-NonManifoldReport remove_non_manifold_vertices(std::vector<Triangle>& triangles,
-                                               std::size_t vertex_count) {
-  std::vector<Index> all(vertex_count);
-  std::iota(all.begin(), all.end(), Index{0});
-  return remove_non_manifold_vertices_at(triangles, vertex_count, all);
-}
-
 // finished empty: every vertex is finished.
 NonManifoldReport mark_non_manifold_fans(std::span<const Triangle> triangles,
                                          std::size_t vertex_count, std::span<const Index> suspects,
@@ -125,21 +118,6 @@ NonManifoldReport mark_non_manifold_fans(std::span<const Triangle> triangles,
     }
   }
 
-  return report;
-}
-
-NonManifoldReport remove_non_manifold_vertices_at(std::vector<Triangle>& triangles,
-                                                  std::size_t vertex_count,
-                                                  std::span<const Index> suspects) {
-  std::vector<std::uint8_t> dead;
-  std::vector<Index> deferred;
-  const NonManifoldReport report =
-      mark_non_manifold_fans(triangles, vertex_count, suspects, {}, dead, deferred);
-  std::size_t out = 0;
-  for (std::size_t t = 0; t < triangles.size(); ++t) {
-    if (!dead[t]) triangles[out++] = triangles[t];
-  }
-  triangles.resize(out);
   return report;
 }
 

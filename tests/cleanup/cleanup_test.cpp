@@ -1,6 +1,7 @@
 // Tests of the post-processing of a grown mesh (src/cleanup/cleanup.hpp, docs/algorithm.md §5):
 // non-manifold vertex removal on hand-made fans whose answer is known, on a cascade, on random
-// damage to a closed surface, and the orientation of whole components.
+// damage to a closed surface, and the orientation of whole components, each through the calls
+// the pipeline makes (mark_non_manifold_fans, group_flips).
 #include "cleanup/cleanup.hpp"
 
 #include <gtest/gtest.h>
@@ -9,8 +10,11 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <numbers>
+#include <numeric>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "g2s/stats.hpp"
@@ -89,6 +93,60 @@ Vec3 normal_of(const Triangle& t, const std::vector<Vec3f>& pos) {
   return cross(b - a, c - a);
 }
 
+// The clean-up as the pipeline runs it (the grower, grow_tile and the stitcher's release):
+// mark_non_manifold_fans with every vertex a suspect and every star finished; the marked
+// triangles are then erased, the others keep their order.
+g2s::NonManifoldReport remove_extra_fans(std::vector<Triangle>& tris, std::size_t vertex_count) {
+  std::vector<Index> every(vertex_count);
+  std::iota(every.begin(), every.end(), Index{0});
+  std::vector<std::uint8_t> dead;
+  std::vector<Index> deferred;
+  const g2s::NonManifoldReport report =
+      g2s::mark_non_manifold_fans(tris, vertex_count, every, {}, dead, deferred);
+  EXPECT_TRUE(deferred.empty());
+  EXPECT_EQ(report.vertices_unjudged, 0u);
+  std::size_t kept = 0;
+  for (std::size_t t = 0; t < tris.size(); ++t) {
+    if (!dead[t]) tris[kept++] = tris[t];
+  }
+  tris.resize(kept);
+  return report;
+}
+
+// Orients `tris` as the stitcher does: each triangle is an orientation group of its own with its
+// sums (GroupSums' fields, positions from the origin), groups whose triangles share an edge are
+// joined (parity 1 where both run along the edge the same way), and group_flips turns each
+// component as a whole. Returns the number of components reversed.
+std::uint64_t orient_as_stitched(std::vector<Triangle>& tris, const std::vector<Vec3f>& pos) {
+  g2s::ParityUnionFind groups;
+  std::vector<g2s::GroupSums> sums(tris.size());
+  std::map<std::pair<Index, Index>, std::pair<std::uint32_t, bool>> first_use;
+  for (std::uint32_t t = 0; t < tris.size(); ++t) {
+    groups.add();
+    const Triangle& c = tris[t];
+    const Vec3 a(pos[c[0]]), b(pos[c[1]]), d(pos[c[2]]);
+    sums[t].det = dot(a, cross(b, d));
+    sums[t].normal = cross(b - a, d - a);
+    sums[t].centroid = a + b + d;
+    sums[t].corners = 3;
+    sums[t].edge_keys =
+        g2s::edge_key(c[0], c[1]) ^ g2s::edge_key(c[1], c[2]) ^ g2s::edge_key(c[2], c[0]);
+    for (int k = 0; k < 3; ++k) {
+      const Index u = c[k], v = c[(k + 1) % 3];
+      const auto [at, fresh] = first_use.try_emplace(std::minmax(u, v), t, u < v);
+      if (!fresh) {
+        EXPECT_TRUE(groups.unite(at->second.first, t, at->second.second == (u < v)));
+      }
+    }
+  }
+  std::uint64_t flipped = 0;
+  const std::vector<std::uint8_t> flip = g2s::group_flips(groups, sums, true, flipped);
+  for (std::uint32_t t = 0; t < tris.size(); ++t) {
+    if (flip[t]) std::swap(tris[t][1], tris[t][2]);
+  }
+  return flipped;
+}
+
 // --- non-manifold vertices ----------------------------------------------------------------------
 
 TEST(NonManifoldRemoval, TypeIExtraTriangleTouchingAClosedFanIsRemoved) {
@@ -101,7 +159,7 @@ TEST(NonManifoldRemoval, TypeIExtraTriangleTouchingAClosedFanIsRemoved) {
         extra_first ? concat({extra, kOctahedron}) : concat({kOctahedron, extra});
     const g2s::MeshStats before = stats_of(points, tris);
     ASSERT_EQ(before.non_manifold_vertices_type1, 1u);
-    const auto report = g2s::remove_non_manifold_vertices(tris, points.size());
+    const auto report = remove_extra_fans(tris, points.size());
     EXPECT_EQ(tris, kOctahedron) << "extra first: " << extra_first;
     EXPECT_EQ(report.vertices_fixed, 1u);
     EXPECT_EQ(report.triangles_removed, 1u);
@@ -120,7 +178,7 @@ TEST(NonManifoldRemoval, TypeIKeepsTheClosedFanEvenWhenAnOpenFanIsLarger) {
   }
   std::vector<Triangle> tris = concat({open_fan, kOctahedron});
   ASSERT_EQ(stats_of(points, tris).non_manifold_vertices_type1, 1u);
-  const auto report = g2s::remove_non_manifold_vertices(tris, points.size());
+  const auto report = remove_extra_fans(tris, points.size());
   EXPECT_EQ(tris, kOctahedron);
   EXPECT_EQ(report.triangles_removed, 6u);
   EXPECT_EQ(stats_of(points, tris).non_manifold_vertices, 0u);
@@ -137,7 +195,7 @@ TEST(NonManifoldRemoval, TypeIITheSmallerOfTwoOpenFansIsRemoved) {
     const g2s::MeshStats before = stats_of(points, tris);
     ASSERT_EQ(before.non_manifold_vertices_type2, 1u);
     ASSERT_EQ(before.non_manifold_vertices, 1u);
-    const auto report = g2s::remove_non_manifold_vertices(tris, points.size());
+    const auto report = remove_extra_fans(tris, points.size());
     EXPECT_EQ(tris, concat({b1, b2, b3})) << "small first: " << small_first;
     EXPECT_EQ(report.vertices_fixed, 1u);
     EXPECT_EQ(report.triangles_removed, 2u);
@@ -157,7 +215,7 @@ TEST(NonManifoldRemoval, CascadeWhenRemovingAFanSplitsAnAlreadyVisitedVertex) {
   const g2s::MeshStats before = stats_of(points, tris);
   ASSERT_EQ(before.non_manifold_vertices, 1u);
   ASSERT_EQ(before.orientation_conflicts, 0u);
-  const auto report = g2s::remove_non_manifold_vertices(tris, points.size());
+  const auto report = remove_extra_fans(tris, points.size());
   EXPECT_EQ(tris, (std::vector<Triangle>{x1, b1, b2, x2, b3}));
   EXPECT_EQ(report.vertices_fixed, 2u);
   EXPECT_EQ(report.triangles_removed, 3u);
@@ -211,7 +269,7 @@ TEST(NonManifoldRemoval, RandomlyDamagedTorusEndsWithoutNonManifoldVertices) {
     }
     const g2s::MeshStats before = stats_of(base.points, damaged);
     std::vector<Triangle> tris = damaged;
-    const auto report = g2s::remove_non_manifold_vertices(tris, base.points.size());
+    const auto report = remove_extra_fans(tris, base.points.size());
     const g2s::MeshStats after = stats_of(base.points, tris);
     EXPECT_EQ(after.non_manifold_vertices, 0u) << "seed " << seed;
     EXPECT_EQ(after.non_manifold_edges, 0u);
@@ -221,7 +279,7 @@ TEST(NonManifoldRemoval, RandomlyDamagedTorusEndsWithoutNonManifoldVertices) {
     EXPECT_TRUE(is_subsequence(tris, damaged)) << "survivors must keep their order";
     // A second pass has nothing left to do.
     std::vector<Triangle> again = tris;
-    const auto second = g2s::remove_non_manifold_vertices(again, base.points.size());
+    const auto second = remove_extra_fans(again, base.points.size());
     EXPECT_EQ(second.triangles_removed, 0u);
     EXPECT_EQ(again, tris);
     fixed_total += report.vertices_fixed;
@@ -246,7 +304,7 @@ TEST(NonManifoldRemoval, ManifoldMeshesAreLeftUntouched) {
   std::vector<Triangle> tris = concat({kOctahedron, torus_part, strip_part});
   ASSERT_EQ(stats_of(points, tris).non_manifold_vertices, 0u);
   const std::vector<Triangle> original = tris;
-  const auto report = g2s::remove_non_manifold_vertices(tris, points.size());
+  const auto report = remove_extra_fans(tris, points.size());
   EXPECT_EQ(tris, original);
   EXPECT_EQ(report.vertices_fixed, 0u);
   EXPECT_EQ(report.triangles_removed, 0u);
@@ -254,9 +312,29 @@ TEST(NonManifoldRemoval, ManifoldMeshesAreLeftUntouched) {
 
 TEST(NonManifoldRemoval, EmptyInputAndUnusedVerticesAreFine) {
   std::vector<Triangle> none;
-  const auto report = g2s::remove_non_manifold_vertices(none, 100);
+  const auto report = remove_extra_fans(none, 100);
   EXPECT_TRUE(none.empty());
   EXPECT_EQ(report.triangles_removed, 0u);
+}
+
+TEST(NonManifoldRemoval, UnfinishedCornersAreDeferredAndBrokenStarsCounted) {
+  // Vertex 0: fan A = {a1, a2} over 1-2-3 goes, fan B = {b1, b2, b3} stays. Of the corners A's
+  // deletion may split, 1 is not finished yet (deferred, to be judged later), 2 is judged now and
+  // 3's star is no longer whole (counted as unjudged).
+  const std::vector<Triangle> tris{{0, 1, 2}, {0, 2, 3}, {0, 4, 5}, {0, 5, 6}, {0, 6, 7}};
+  std::vector<std::uint8_t> finished(8, 1);
+  finished[1] = 0;
+  finished[3] = 2;
+  const std::vector<Index> suspects{0};
+  std::vector<std::uint8_t> dead;
+  std::vector<Index> deferred;
+  const g2s::NonManifoldReport report =
+      g2s::mark_non_manifold_fans(tris, 8, suspects, finished, dead, deferred);
+  EXPECT_EQ(dead, (std::vector<std::uint8_t>{1, 1, 0, 0, 0}));
+  EXPECT_EQ(deferred, std::vector<Index>{1});
+  EXPECT_EQ(report.vertices_fixed, 1u);
+  EXPECT_EQ(report.triangles_removed, 2u);
+  EXPECT_EQ(report.vertices_unjudged, 1u);
 }
 
 // --- orientation --------------------------------------------------------------------------------
@@ -265,15 +343,28 @@ TEST(OrientComponents, InwardOctahedronIsFlippedOutward) {
   const std::vector<Vec3f> pos = as_floats(kOctahedronPoints);
   std::vector<Triangle> tris = reversed(kOctahedron);
   ASSERT_LT(signed_volume(tris, pos), 0);
-  EXPECT_EQ(g2s::orient_components(tris, pos), 1u);
+  EXPECT_EQ(orient_as_stitched(tris, pos), 1u);
   EXPECT_GT(signed_volume(tris, pos), 0);
   EXPECT_EQ(tris, kOctahedron);
+}
+
+TEST(OrientComponents, TrianglesGrownInDisagreementAreMadeConsistentAndOutward) {
+  // Seeds of either orientation met in one component: the parity of the joined groups turns
+  // every triangle to agree, then the component faces outward.
+  const std::vector<Vec3f> pos = as_floats(kOctahedronPoints);
+  for (const std::vector<std::size_t>& turned :
+       {std::vector<std::size_t>{0, 5}, {1, 2, 3}, {0, 1, 2, 3, 4, 6}}) {
+    std::vector<Triangle> tris = kOctahedron;
+    for (std::size_t t : turned) std::swap(tris[t][1], tris[t][2]);
+    orient_as_stitched(tris, pos);
+    EXPECT_EQ(tris, kOctahedron) << turned.size() << " turned";
+  }
 }
 
 TEST(OrientComponents, OutwardOctahedronIsLeftAlone) {
   const std::vector<Vec3f> pos = as_floats(kOctahedronPoints);
   std::vector<Triangle> tris = kOctahedron;
-  EXPECT_EQ(g2s::orient_components(tris, pos), 0u);
+  EXPECT_EQ(orient_as_stitched(tris, pos), 0u);
   EXPECT_EQ(tris, kOctahedron);
 }
 
@@ -291,7 +382,7 @@ TEST(OrientComponents, ComponentsAreOrientedIndependently) {
   for (std::size_t k = 0; k < kOctahedron.size(); ++k) {
     for (const auto& part : parts) tris.push_back(part[k]);
   }
-  EXPECT_EQ(g2s::orient_components(tris, pos), 2u);
+  EXPECT_EQ(orient_as_stitched(tris, pos), 2u);
   for (Index c = 0; c < 3; ++c) {
     std::vector<Triangle> mine;
     for (const Triangle& t : tris) {
@@ -327,11 +418,11 @@ TEST(OrientComponents, OpenHorizontalPatchFacingDownIsFlippedUp) {
   const std::vector<Vec3f> pos = as_floats(points);
   std::vector<Triangle> tris = reversed(up);
   for (const Triangle& t : tris) ASSERT_LT(normal_of(t, pos).z, 0);
-  EXPECT_EQ(g2s::orient_components(tris, pos), 1u);
+  EXPECT_EQ(orient_as_stitched(tris, pos), 1u);
   EXPECT_EQ(tris, up);
   for (const Triangle& t : tris) EXPECT_GT(normal_of(t, pos).z, 0);
   // Facing up already: nothing to do.
-  EXPECT_EQ(g2s::orient_components(tris, pos), 0u);
+  EXPECT_EQ(orient_as_stitched(tris, pos), 0u);
   EXPECT_EQ(tris, up);
 }
 
@@ -342,7 +433,7 @@ TEST(OrientComponents, TwoOpenPatchesOneDownOneUpOnlyTheDownOneFlips) {
   height_patch(8, 8, 20.0, points, second);
   const std::vector<Vec3f> pos = as_floats(points);
   std::vector<Triangle> tris = concat({second, reversed(first)});
-  EXPECT_EQ(g2s::orient_components(tris, pos), 1u);
+  EXPECT_EQ(orient_as_stitched(tris, pos), 1u);
   EXPECT_EQ(tris, concat({second, first}));
 }
 
@@ -371,7 +462,7 @@ TEST(OrientComponents, OpenVerticalCylinderFacingInwardIsFlippedOutward) {
     ASSERT_GT(dot(normal_of(t, pos), Vec3{c.x - 4, c.y + 3, 0}), 0);
   }
   std::vector<Triangle> tris = reversed(outward);
-  EXPECT_EQ(g2s::orient_components(tris, pos), 1u);
+  EXPECT_EQ(orient_as_stitched(tris, pos), 1u);
   EXPECT_EQ(tris, outward);
 }
 
@@ -382,7 +473,7 @@ TEST(OrientComponents, MixedClosedAndOpenComponents) {
   height_patch(6, 6, 10.0, points, patch);
   const std::vector<Vec3f> pos = as_floats(points);
   std::vector<Triangle> tris = concat({reversed(patch), reversed(kOctahedron)});
-  EXPECT_EQ(g2s::orient_components(tris, pos), 2u);
+  EXPECT_EQ(orient_as_stitched(tris, pos), 2u);
   EXPECT_EQ(tris, concat({patch, kOctahedron}));
 }
 

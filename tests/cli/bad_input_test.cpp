@@ -26,8 +26,9 @@
 #include <vector>
 
 #include "g2s/io.hpp"
-#include "support/cli_runner.hpp"
+#include "support/cli.hpp"
 #include "support/temp_folder.hpp"
+#include "support/unprivileged.hpp"
 
 namespace {
 
@@ -41,6 +42,7 @@ constexpr int kNoSurface = 5;
 
 using g2s::test_support::CliRun;
 using g2s::test_support::file_bytes;
+using g2s::test_support::json_number;
 
 // A 30 x 30 grid of points 0.125 apart, exact in binary, on the surface z = height(x, y).
 template <typename Height>
@@ -85,26 +87,11 @@ std::string xyz_text(const std::vector<Point>& points) {
   return text;
 }
 
-// Reads the number after "key": in a JSON text (g2s stats --json, g2s mesh --json).
-double json_number(const std::string& json, const std::string& key) {
-  const std::string quoted = "\"" + key + "\":";
-  const std::size_t at = json.find(quoted);
-  if (at == std::string::npos) {
-    ADD_FAILURE() << "no " << quoted << " in " << json;
-    return std::numeric_limits<double>::quiet_NaN();
-  }
-  return std::strtod(json.c_str() + at + quoted.size(), nullptr);
-}
-
-class BadInput : public ::testing::Test {
+class BadInput : public g2s::test_support::FolderTest {
  protected:
-  fs::path write(const std::string& name, std::string_view bytes) {
-    return folder_.write(name, bytes);
-  }
-
   // Runs the g2s CLI with `args`; a run past `seconds` is killed and fails the test as a hang.
   CliRun run(const std::vector<std::string>& args, double seconds = 60.0) {
-    return g2s::test_support::run_cli(dir_, args, seconds, unprivileged_);
+    return g2s::test_support::run_cli(dir_, args, {.seconds = seconds, .as_nobody = unprivileged_});
   }
 
   // `g2s mesh input -o output` plus extra arguments.
@@ -118,7 +105,7 @@ class BadInput : public ::testing::Test {
   // failed.
   void expect_failure(const CliRun& r, int code, std::initializer_list<std::string_view> parts,
                       const fs::path& output) {
-    EXPECT_EQ(r.exit_code, code) << r.err;
+    EXPECT_EQ(r.code, code) << r.err;
     EXPECT_NE(r.err.find("g2s: error: "), std::string::npos) << r.err;
     for (std::string_view part : parts) {
       EXPECT_NE(r.err.find(part), std::string::npos)
@@ -134,13 +121,9 @@ class BadInput : public ::testing::Test {
   void run_unprivileged() {
     if (::geteuid() != 0) return;
     unprivileged_ = true;
-    fs::permissions(dir_, fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec |
-                              fs::perms::others_read | fs::perms::others_exec);
+    g2s::test_support::open_to_others(dir_);
   }
   bool unprivileged_ = false;
-
-  g2s::test_support::TempFolder folder_{"g2s-bad-input"};
-  const fs::path dir_ = folder_.path();
 };
 
 TEST_F(BadInput, EmptyFileIsBadInput) {
@@ -173,7 +156,7 @@ TEST_F(BadInput, HeaderDeclaringMorePointsThanTheBodyHoldsIsTruncated) {
 TEST_F(BadInput, HeaderDeclaringFewerPointsMeshesThemAndNotesTheRest) {
   const fs::path in = write("fewer.ply", binary_ply(wavy_patch(), 890, false));
   const CliRun r = mesh(in, out());
-  ASSERT_EQ(r.exit_code, kOk) << r.err;
+  ASSERT_EQ(r.code, kOk) << r.err;
   EXPECT_NE(r.err.find("120 bytes after the 890 declared vertices ignored"), std::string::npos)
       << r.err;
   const g2s::IndexedMesh written = g2s::read_mesh(out());
@@ -214,9 +197,9 @@ TEST_F(BadInput, BigEndianMeshesExactlyLikeLittleEndian) {
   const fs::path le_mesh = dir_ / "le-mesh.ply";
   const fs::path be_mesh = dir_ / "be-mesh.ply";
   const CliRun from_le = mesh(le, le_mesh);
-  ASSERT_EQ(from_le.exit_code, kOk) << from_le.err;
+  ASSERT_EQ(from_le.code, kOk) << from_le.err;
   const CliRun from_be = mesh(be, be_mesh);
-  ASSERT_EQ(from_be.exit_code, kOk) << from_be.err;
+  ASSERT_EQ(from_be.code, kOk) << from_be.err;
   const std::string le_bytes = file_bytes(le_mesh);
   EXPECT_GT(g2s::read_mesh(le_mesh).triangles.size(), 1500u);
   EXPECT_TRUE(le_bytes == file_bytes(be_mesh)) << "the two meshes differ";
@@ -235,7 +218,7 @@ TEST_F(BadInput, NanAndInfPointsAreDroppedCountedAndTheRestMeshes) {
   text += "nan 0 0\n0 inf 0\n0 0 -inf\n";
   const fs::path in = write("nan.xyz", text);
   const CliRun r = mesh(in, out(), {"--json"});
-  ASSERT_EQ(r.exit_code, kOk) << r.err;
+  ASSERT_EQ(r.code, kOk) << r.err;
   EXPECT_NE(r.err.find("3 points with NaN or Inf coordinates dropped"), std::string::npos) << r.err;
   EXPECT_EQ(json_number(r.out, "non_finite"), 3.0) << r.out;
   EXPECT_EQ(json_number(r.out, "points"), 900.0) << r.out;
@@ -266,9 +249,9 @@ TEST_F(BadInput, AllPointsCoplanarMeshAsAnOpenSurface) {
   const fs::path in = write(
       "plane.xyz", xyz_text(grid_points([](double x, double y) { return 0.5 * x + 0.25 * y; })));
   const CliRun r = mesh(in, out());
-  ASSERT_EQ(r.exit_code, kOk) << r.err;
+  ASSERT_EQ(r.code, kOk) << r.err;
   const CliRun stats = run({"stats", out().string(), "--points", in.string(), "--json"});
-  ASSERT_EQ(stats.exit_code, kOk) << stats.err;
+  ASSERT_EQ(stats.code, kOk) << stats.err;
   const std::string json = stats.out;
   EXPECT_EQ(json_number(json, "non_manifold_edges"), 0.0) << json;
   EXPECT_EQ(json_number(json, "non_manifold_vertices"), 0.0) << json;
@@ -300,7 +283,7 @@ TEST_F(BadInput, GeoreferencedCoordinatesMeshLocallyAndAreWrittenBackExactly) {
   }
   const fs::path in = write("geo.xyz", xyz_text(points));
   const CliRun r = mesh(in, out());
-  ASSERT_EQ(r.exit_code, kOk) << r.err;
+  ASSERT_EQ(r.code, kOk) << r.err;
   const g2s::IndexedMesh written = g2s::read_mesh(out());
   EXPECT_GT(written.triangles.size(), 1500u);
   const std::set<Point> input(points.begin(), points.end());
@@ -312,7 +295,7 @@ TEST_F(BadInput, GeoreferencedCoordinatesMeshLocallyAndAreWrittenBackExactly) {
         v, p[0], p[1], p[2]);
   }
   const CliRun stats = run({"stats", out().string(), "--points", in.string(), "--json"});
-  ASSERT_EQ(stats.exit_code, kOk) << stats.err;
+  ASSERT_EQ(stats.code, kOk) << stats.err;
   EXPECT_EQ(json_number(stats.out, "non_manifold_vertices"), 0.0) << stats.out;
   EXPECT_EQ(json_number(stats.out, "degenerate_triangles"), 0.0) << stats.out;
   EXPECT_GE(json_number(stats.out, "coverage"), 0.99) << stats.out;
@@ -324,7 +307,7 @@ TEST_F(BadInput, GeoreferencedCoordinatesToStlWarnAboutFloatRounding) {
   for (Point& p : points) p = {1.0e7 + 0.08 * p[0], 5.0e6 + 0.08 * p[1], 250.0 + 0.08 * p[2]};
   const fs::path stl = dir_ / "geo.stl";
   const CliRun r = mesh(write("geo.xyz", xyz_text(points)), stl);
-  ASSERT_EQ(r.exit_code, kOk) << r.err;
+  ASSERT_EQ(r.code, kOk) << r.err;
   EXPECT_NE(r.err.find("warning: " + stl.string() + ": STL stores 32-bit floats"),
             std::string::npos)
       << r.err;
@@ -351,9 +334,9 @@ TEST_F(BadInput, DuplicatePointsAreMerged) {
   doubled.insert(doubled.end(), points.begin(), points.begin() + 100);
   const fs::path distinct_mesh = dir_ / "distinct.ply";
   const CliRun distinct = mesh(write("distinct.xyz", xyz_text(points)), distinct_mesh);
-  ASSERT_EQ(distinct.exit_code, kOk) << distinct.err;
+  ASSERT_EQ(distinct.code, kOk) << distinct.err;
   const CliRun r = mesh(write("doubled.xyz", xyz_text(doubled)), out(), {"--json"});
-  ASSERT_EQ(r.exit_code, kOk) << r.err;
+  ASSERT_EQ(r.code, kOk) << r.err;
   EXPECT_NE(r.err.find("100 duplicate points merged"), std::string::npos) << r.err;
   EXPECT_EQ(json_number(r.out, "duplicates_merged"), 100.0) << r.out;
   EXPECT_TRUE(file_bytes(out()) == file_bytes(distinct_mesh)) << "duplicates changed the mesh";

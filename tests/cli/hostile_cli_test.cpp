@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "g2s/io.hpp"
-#include "support/cli_runner.hpp"
+#include "support/cli.hpp"
 #include "support/temp_folder.hpp"
 #include "tiling/xxhash64.hpp"
 
@@ -45,7 +45,7 @@ class HostileCli : public ::testing::Test {
   // A synthetic cloud of `points` points of `shape`, written once per test.
   fs::path cloud(const std::string& name, const std::string& shape, const std::string& points) {
     const CliRun r = run({"synth", shape, "--points", points, "-o", path(name).string()});
-    EXPECT_EQ(r.exit_code, kOk) << r.err;
+    EXPECT_EQ(r.code, kOk) << r.err;
     return path(name);
   }
   fs::path write(const std::string& name, const std::string& text) {
@@ -53,7 +53,7 @@ class HostileCli : public ::testing::Test {
     return path(name);
   }
   static void expect_says(const CliRun& r, int code, const std::vector<std::string>& parts) {
-    EXPECT_EQ(r.exit_code, code) << r.err;
+    EXPECT_EQ(r.code, code) << r.err;
     for (const std::string& part : parts) {
       EXPECT_NE(r.err.find(part), std::string::npos) << "stderr: " << r.err << "\nwants: " << part;
     }
@@ -112,10 +112,10 @@ TEST_F(HostileCli, KeptStoreOfAnotherCloudIsNotReused) {
   const fs::path a = cloud("a.ply", "sphere", "3000");
   const fs::path b = cloud("b.ply", "torus", "3000");
   const std::string store = path("k.store").string();
-  ASSERT_EQ(run({"mesh", b.string(), "-o", path("b-alone.ply").string(), "-q"}).exit_code, kOk);
+  ASSERT_EQ(run({"mesh", b.string(), "-o", path("b-alone.ply").string(), "-q"}).code, kOk);
   ASSERT_EQ(
       run({"mesh", a.string(), "-o", path("a.ply.out.ply").string(), "-q", "--keep-store", store})
-          .exit_code,
+          .code,
       kOk);
   // A's store is newer than B: it must not be taken for B's.
   const CliRun r =
@@ -129,7 +129,7 @@ TEST_F(HostileCli, KeptStoreOfAnotherCloudIsNotReused) {
   // The same input and options reuse it silently.
   const CliRun again = run({"mesh", b.string(), "-o", path("b3.ply").string(), "--keep-store",
                             store, "--tile-points", "1000"});
-  EXPECT_EQ(again.exit_code, kOk);
+  EXPECT_EQ(again.code, kOk);
   EXPECT_EQ(again.err.find("tiling again"), std::string::npos) << again.err;
   // A store of an older format version (here: its version field set to 1) is cut again by
   // mesh, refused by grow.
@@ -153,8 +153,8 @@ TEST_F(HostileCli, KeptStoreOfAnotherCloudIsNotReused) {
 TEST_F(HostileCli, GrowthsMadeWithOtherOptions) {
   const fs::path in = cloud("in.ply", "torus", "4000");
   const std::string store = path("s.store").string();
-  ASSERT_EQ(run({"tile", in.string(), store, "-q", "--tile-points", "1500"}).exit_code, kOk);
-  ASSERT_EQ(run({"grow", store, "-q"}).exit_code, kOk);
+  ASSERT_EQ(run({"tile", in.string(), store, "-q", "--tile-points", "1500"}).code, kOk);
+  ASSERT_EQ(run({"grow", store, "-q"}).code, kOk);
   const CliRun regrow = run({"grow", store, "--max-radius", "2"});
   expect_says(regrow, kOk, {"(0 already there)"});
   expect_says(run({"stitch", store, "-o", path("m.ply").string()}), kUsage,
@@ -213,7 +213,7 @@ TEST_F(HostileCli, OptionsThatCannotWork) {
   };
   for (const auto& [args, says] : cases) {
     const CliRun r = run(args);
-    EXPECT_EQ(r.exit_code, kUsage) << fmt::format("{}", fmt::join(args, " ")) << "\n" << r.err;
+    EXPECT_EQ(r.code, kUsage) << fmt::format("{}", fmt::join(args, " ")) << "\n" << r.err;
     EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
     EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "not one line: " << r.err;
     EXPECT_LT(r.err.size(), 200u) << r.err;
@@ -228,7 +228,7 @@ TEST_F(HostileCli, UnsupportedOutputFormats) {
   expect_says(run({"mesh", in, "-o", path("mesh").string()}), kUsage, {"no extension"});
   expect_says(run({"mesh", in, "-o", path("m.ply").string(), "--ascii"}), kUsage,
               {"--ascii applies to STL only"});
-  ASSERT_EQ(run({"mesh", in, "-o", path("m.stl").string(), "-q"}).exit_code, kOk);
+  ASSERT_EQ(run({"mesh", in, "-o", path("m.stl").string(), "-q"}).code, kOk);
   expect_says(run({"render", path("m.stl").string(), "-o", path("m.jpg").string()}), kUsage,
               {"must end in .png"});
   expect_says(run({"synth", "--from", in, "-o", path("c.xyz").string()}), kUsage,
@@ -239,8 +239,7 @@ TEST_F(HostileCli, UnsupportedOutputFormats) {
 // Item 10: endless devices are refused by every command that reads.
 TEST_F(HostileCli, EndlessDevicesAreBadInput) {
   const std::string mesh = path("m.stl").string();
-  ASSERT_EQ(run({"mesh", cloud("in.ply", "sphere", "2000").string(), "-o", mesh, "-q"}).exit_code,
-            kOk);
+  ASSERT_EQ(run({"mesh", cloud("in.ply", "sphere", "2000").string(), "-o", mesh, "-q"}).code, kOk);
   for (const std::vector<std::string>& args :
        {std::vector<std::string>{"stats", "/dev/zero"},
         {"stats", mesh, "--points", "/dev/zero"},
@@ -269,7 +268,7 @@ TEST_F(HostileCli, RenderLeavesOutNonFiniteTriangles) {
                               "property float y\nproperty float z\nelement face 0\n"
                               "property list uchar int vertex_indices\nend_header\n0 0 0\n");
   ASSERT_EQ(
-      run({"render", none.string(), "-o", path("blank.png").string(), "--size", "64x64"}).exit_code,
+      run({"render", none.string(), "-o", path("blank.png").string(), "--size", "64x64"}).code,
       kOk);
   EXPECT_GT(png.size(), file_bytes(path("blank.png")).size());
 }
@@ -280,13 +279,13 @@ TEST_F(HostileCli, JsonEscapesPaths) {
   const fs::path in = cloud("q\"uote\\d/in.ply", "sphere", "2000");
   const std::string out = (dir_ / "q\"uote\\d" / "m.ply").string();
   const CliRun mesh = run({"mesh", in.string(), "-o", out, "--json"});
-  ASSERT_EQ(mesh.exit_code, kOk) << mesh.err;
+  ASSERT_EQ(mesh.code, kOk) << mesh.err;
   EXPECT_NE(mesh.out.find("q\\\"uote\\\\d/in.ply"), std::string::npos) << mesh.out;
   const std::string store = (dir_ / "q\"uote\\d" / "s.store").string();
-  ASSERT_EQ(run({"tile", in.string(), store, "-q"}).exit_code, kOk);
-  ASSERT_EQ(run({"grow", store, "-q"}).exit_code, kOk);
+  ASSERT_EQ(run({"tile", in.string(), store, "-q"}).code, kOk);
+  ASSERT_EQ(run({"grow", store, "-q"}).code, kOk);
   const CliRun stitch = run({"stitch", store, "-o", out, "--json"});
-  ASSERT_EQ(stitch.exit_code, kOk) << stitch.err;
+  ASSERT_EQ(stitch.code, kOk) << stitch.err;
   EXPECT_NE(stitch.out.find("q\\\"uote\\\\d/s.store"), std::string::npos) << stitch.out;
   EXPECT_EQ(stitch.out.find("q\"uote"), std::string::npos) << stitch.out;
 }
@@ -301,7 +300,7 @@ TEST_F(HostileCli, MessagesNameTheUsersFiles) {
     }
   }
   const CliRun dup = run({"mesh", write("dup.xyz", text).string(), "-o", path("d.ply").string()});
-  EXPECT_EQ(dup.exit_code, kOk) << dup.err;
+  EXPECT_EQ(dup.code, kOk) << dup.err;
   EXPECT_EQ(dup.err.find("stray point"), std::string::npos) << dup.err;
   const CliRun from =
       run({"synth", "--from", write("one.xyz", "1 2 3\n").string(), "-o", path("o.ply").string()});
@@ -310,8 +309,8 @@ TEST_F(HostileCli, MessagesNameTheUsersFiles) {
   // stitcher's check names the file and the tile.
   const fs::path in = cloud("in.ply", "sphere", "2000");
   const std::string store = path("s.store").string();
-  ASSERT_EQ(run({"tile", in.string(), store, "-q"}).exit_code, kOk);
-  ASSERT_EQ(run({"grow", store, "-q"}).exit_code, kOk);
+  ASSERT_EQ(run({"tile", in.string(), store, "-q"}).code, kOk);
+  ASSERT_EQ(run({"grow", store, "-q"}).code, kOk);
   const fs::path growth = fs::path(store + ".grown") / "tile-000000.g2sgrow";
   std::string bytes = file_bytes(growth);
   ASSERT_GT(bytes.size(), 128u);
@@ -330,7 +329,7 @@ TEST_F(HostileCli, MessagesNameTheUsersFiles) {
 TEST_F(HostileCli, GrownFolderThatCannotBeMade) {
   const fs::path in = cloud("in.ply", "sphere", "2000");
   const std::string store = path("s.store").string();
-  ASSERT_EQ(run({"tile", in.string(), store, "-q"}).exit_code, kOk);
+  ASSERT_EQ(run({"tile", in.string(), store, "-q"}).code, kOk);
   expect_says(run({"grow", store, "--grown", in.string()}), kWriteFailed,
               {in.string(), "cannot make the folder"});
 }
@@ -339,28 +338,17 @@ TEST_F(HostileCli, GrownFolderThatCannotBeMade) {
 TEST_F(HostileCli, SignalDuringTheSummaryKeepsTheCompleteFileAndSaysSo) {
   const fs::path in = cloud("in.ply", "sphere", "300k");
   const fs::path out = path("m.ply");
-  const fs::path err_path = path("signal.stderr");
-  const pid_t pid = fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    const int err = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (err < 0 || dup2(err, STDERR_FILENO) < 0) _exit(127);
-    execl(G2S_CLI_PATH, "g2s", "mesh", in.c_str(), "-o", out.c_str(), "--threads", "1",
-          static_cast<char*>(nullptr));
-    _exit(127);
-  }
+  g2s::test_support::CliChild child(dir_,
+                                    {"mesh", in.string(), "-o", out.string(), "--threads", "1"});
   while (!fs::exists(out)) {
-    int status = 0;
-    if (waitpid(pid, &status, WNOHANG) == pid) FAIL() << "g2s ended before writing " << out;
+    if (child.ended()) FAIL() << "g2s ended before writing " << out;
     std::this_thread::sleep_for(std::chrono::microseconds(200));
   }
-  kill(pid, SIGINT);
-  int status = 0;
-  ASSERT_EQ(waitpid(pid, &status, 0), pid);
-  ASSERT_TRUE(WIFEXITED(status));
-  const std::string err = file_bytes(err_path);
-  if (WEXITSTATUS(status) == 0) GTEST_SKIP() << "the summary ended before the signal arrived";
-  EXPECT_EQ(WEXITSTATUS(status), 130) << err;
+  child.send(SIGINT);
+  const g2s::test_support::CliRun r = child.wait();
+  const std::string& err = r.err;
+  if (r.code == 0) GTEST_SKIP() << "the summary ended before the signal arrived";
+  EXPECT_EQ(r.code, 130) << err;
   EXPECT_EQ(err.find("no output written"), std::string::npos) << err;
   EXPECT_NE(err.find("is complete"), std::string::npos) << err;
   EXPECT_GT(g2s::read_mesh(out).triangles.size(), 500000u);

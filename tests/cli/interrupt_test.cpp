@@ -2,13 +2,14 @@
 // being written remove its temporary, leave no target, and exit with code 130.
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <filesystem>
 #include <string>
 #include <thread>
+
+#include "support/cli.hpp"
+#include "support/temp_folder.hpp"
 
 namespace {
 
@@ -17,19 +18,11 @@ namespace fs = std::filesystem;
 class Interrupt : public ::testing::TestWithParam<int> {};
 
 TEST_P(Interrupt, WhileWritingLeavesNoFileAndExits130) {
-  const fs::path dir = fs::temp_directory_path() / ("g2s-interrupt-" + std::to_string(getpid()) +
-                                                    "-" + std::to_string(GetParam()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const g2s::test_support::TempFolder folder("g2s-interrupt");
+  const fs::path& dir = folder.path();
   const std::string out = (dir / "big.ply").string();
-  const pid_t pid = fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    // 200M points: minutes of writing, so the signal always arrives mid-file.
-    execl(G2S_CLI_PATH, "g2s", "synth", "sphere", "--points", "200M", "-o", out.c_str(),
-          static_cast<char*>(nullptr));
-    _exit(127);
-  }
+  // 200M points: minutes of writing, so the signal always arrives mid-file.
+  g2s::test_support::CliChild child(dir, {"synth", "sphere", "--points", "200M", "-o", out});
   // Wait until the temporary file exists, then interrupt.
   bool started = false;
   for (int i = 0; i < 500 && !started; ++i) {
@@ -39,13 +32,10 @@ TEST_P(Interrupt, WhileWritingLeavesNoFileAndExits130) {
     if (!started) std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   EXPECT_TRUE(started) << "no temporary file appeared";
-  kill(pid, GetParam());
-  int status = 0;
-  ASSERT_EQ(waitpid(pid, &status, 0), pid);
-  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
-  EXPECT_EQ(WEXITSTATUS(status), 130);
+  child.send(GetParam());
+  const g2s::test_support::CliRun run = child.wait();
+  EXPECT_EQ(run.code, 130) << run.err;
   EXPECT_TRUE(fs::is_empty(dir)) << "files left in " << dir;
-  fs::remove_all(dir);
 }
 
 INSTANTIATE_TEST_SUITE_P(Signals, Interrupt, ::testing::Values(SIGINT, SIGTERM));

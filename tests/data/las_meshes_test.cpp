@@ -3,63 +3,42 @@
 // orientation conflict, no duplicate or degenerate triangle), and autzen_trim.las gives the mesh
 // of open-autzen-lidar.ply, which holds the same points shifted and rounded to float.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
-#include <limits>
 #include <string>
 
+#include "support/cli.hpp"
 #include "support/temp_folder.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-fs::path data_dir() {
-  const char* env = std::getenv("G2S_DATA_DIR");
-  return env && *env ? fs::path(env) : fs::path(G2S_DEFAULT_DATA_DIR);
-}
-
-// The number after "key": (or "key": ) in a JSON text.
-double json_number(const std::string& json, const std::string& key) {
-  const std::size_t at = json.find("\"" + key + "\":");
-  if (at == std::string::npos) {
-    ADD_FAILURE() << "no " << key << " in " << json;
-    return std::numeric_limits<double>::quiet_NaN();
-  }
-  return std::strtod(json.c_str() + at + key.size() + 3, nullptr);
-}
+using g2s::test_support::data_dir;
+using g2s::test_support::json_number;
 
 class LasMesh : public ::testing::Test {
  protected:
   // `g2s mesh input -o dir/output --json`; returns stdout, fails the test on a non-zero exit.
   std::string mesh(const fs::path& input, const std::string& output) {
-    const fs::path out = folder_.path() / "stdout.txt";
-    const fs::path err = folder_.path() / "stderr.txt";
-    const std::string command = std::string("\"") + G2S_CLI_PATH + "\" mesh \"" + input.string() +
-                                "\" -o \"" + (folder_.path() / output).string() + "\" --json > \"" +
-                                out.string() + "\" 2> \"" + err.string() + "\"";
-    const int status = std::system(command.c_str());
-    std::ifstream o(out), e(err);
-    const std::string json{std::istreambuf_iterator<char>(o), std::istreambuf_iterator<char>()};
-    const std::string errors{std::istreambuf_iterator<char>(e), std::istreambuf_iterator<char>()};
-    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << command << "\n" << errors;
-    return json;
+    const g2s::test_support::CliRun r = g2s::test_support::run_cli(
+        folder_.path(), {"mesh", input.string(), "-o", output, "--json"});
+    EXPECT_EQ(r.code, 0) << input << "\n" << r.err;
+    return r.out;
   }
   g2s::test_support::TempFolder folder_{"g2s-las-mesh"};
 };
 
 TEST_F(LasMesh, EveryRealLasFileMeshesClean) {
-  for (const char* name :
-       {"autzen_trim.las", "test1_4.las", "extrabytes.las", "4_6_crop.las", "simple.las"}) {
+  const char* const names[] = {"autzen_trim.las", "test1_4.las", "extrabytes.las", "4_6_crop.las",
+                               "simple.las"};
+  for (const char* name : names) G2S_SKIP_WITHOUT_DATA(data_dir() / "las" / name);
+  for (const char* name : names) {
     SCOPED_TRACE(name);
     const fs::path path = data_dir() / "las" / name;
-    if (!fs::exists(path)) GTEST_SKIP() << "no " << path << " (set G2S_DATA_DIR)";
     const std::string json = mesh(path, "mesh.ply");
     std::printf("%s: %s\n", name, json.c_str());
     EXPECT_GT(json_number(json, "triangles"), json_number(json, "points"));
@@ -74,7 +53,8 @@ TEST_F(LasMesh, EveryRealLasFileMeshesClean) {
 TEST_F(LasMesh, AutzenLasAndPlyGiveTheSameMesh) {
   const fs::path las = data_dir() / "las" / "autzen_trim.las";
   const fs::path ply = data_dir() / "open-autzen-lidar.ply";
-  if (!fs::exists(las) || !fs::exists(ply)) GTEST_SKIP() << "no autzen files (set G2S_DATA_DIR)";
+  G2S_SKIP_WITHOUT_DATA(las);
+  G2S_SKIP_WITHOUT_DATA(ply);
   const std::string a = mesh(las, "las.ply");
   const std::string b = mesh(ply, "ply.ply");
   EXPECT_EQ(json_number(a, "points"), json_number(b, "points"));

@@ -22,14 +22,7 @@ namespace fs = std::filesystem;
 using g2s::Exit;
 using g2s::test_support::expect_error;
 
-class HostileReaders : public ::testing::Test {
- protected:
-  fs::path write(const std::string& name, std::string_view bytes) {
-    return folder_.write(name, bytes);
-  }
-  g2s::test_support::TempFolder folder_{"g2s-hostile-read"};
-  const fs::path dir_ = folder_.path();
-};
+using HostileReaders = g2s::test_support::FolderTest;
 
 // /dev/zero never ends: reading it whole would fill the memory. Every reader refuses it.
 TEST_F(HostileReaders, DevicesAreRefusedByEveryReader) {

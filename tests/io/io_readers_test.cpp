@@ -35,14 +35,7 @@ namespace fs = std::filesystem;
 using g2s::Exit;
 
 // A fresh folder per test, removed afterwards.
-class IoTempDir : public ::testing::Test {
- protected:
-  fs::path write(const std::string& name, std::string_view bytes) {
-    return folder_.write(name, bytes);
-  }
-  g2s::test_support::TempFolder folder_{"g2s-io-read"};
-  const fs::path dir_ = folder_.path();
-};
+using IoTempDir = g2s::test_support::FolderTest;
 
 using g2s::test_support::expect_error;
 

@@ -20,6 +20,7 @@
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
 #include "io/readers.hpp"
+#include "support/cli.hpp"
 #include "support/las_writer.hpp"
 #include "support/temp_folder.hpp"
 
@@ -245,10 +246,7 @@ TEST_F(LasRead, LazIsRefusedWithHowToDecompress) {
 
 // The LAS files of PDAL's test suite (written by PDAL, Global Mapper, TerraScan), with the
 // counts their README lists; autzen_trim.las holds the points of open-autzen-lidar.ply.
-fs::path data_dir() {
-  const char* env = std::getenv("G2S_DATA_DIR");
-  return env && *env ? fs::path(env) : fs::path(G2S_DEFAULT_DATA_DIR);
-}
+using g2s::test_support::data_dir;
 
 TEST(LasRealFiles, CountsAndBoundsMatchTheReadme) {
   struct Case {
@@ -256,14 +254,15 @@ TEST(LasRealFiles, CountsAndBoundsMatchTheReadme) {
     std::uint64_t points;
     const char* format;
   };
-  for (const Case& c : {Case{"autzen_trim.las", 110000, "las-1.2-format3"},
-                        Case{"test1_4.las", 1000, "las-1.4-format6"},
-                        Case{"extrabytes.las", 1065, "las-1.4-format3"},
-                        Case{"4_6_crop.las", 23875, "las-1.2-format3"},
-                        Case{"simple.las", 1065, "las-1.2-format3"}}) {
+  const Case cases[] = {{"autzen_trim.las", 110000, "las-1.2-format3"},
+                        {"test1_4.las", 1000, "las-1.4-format6"},
+                        {"extrabytes.las", 1065, "las-1.4-format3"},
+                        {"4_6_crop.las", 23875, "las-1.2-format3"},
+                        {"simple.las", 1065, "las-1.2-format3"}};
+  for (const Case& c : cases) G2S_SKIP_WITHOUT_DATA(data_dir() / "las" / c.name);
+  for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
     const fs::path path = data_dir() / "las" / c.name;
-    if (!fs::exists(path)) GTEST_SKIP() << "no " << path << " (set G2S_DATA_DIR)";
     g2s::ReadReport report;
     const g2s::PointCloud cloud = g2s::read_points(path, &report);
     EXPECT_EQ(report.points, c.points);
@@ -277,7 +276,8 @@ TEST(LasRealFiles, CountsAndBoundsMatchTheReadme) {
 TEST(LasRealFiles, AutzenLasHoldsThePointsOfTheAutzenPly) {
   const fs::path las = data_dir() / "las" / "autzen_trim.las";
   const fs::path ply = data_dir() / "open-autzen-lidar.ply";
-  if (!fs::exists(las) || !fs::exists(ply)) GTEST_SKIP() << "no autzen files (set G2S_DATA_DIR)";
+  G2S_SKIP_WITHOUT_DATA(las);
+  G2S_SKIP_WITHOUT_DATA(ply);
   const g2s::PointCloud a = g2s::read_points(las);
   const g2s::PointCloud b = g2s::read_points(ply);
   ASSERT_EQ(a.size(), b.size());

@@ -5,14 +5,9 @@
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <chrono>
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <string>
 #include <thread>
 #include <vector>
@@ -34,32 +29,24 @@ class PipelineFaults : public ::testing::Test {
     g2s::write_synthetic_cloud(dir_ / "cloud.ply", o);
   }
 
-  // Runs the CLI through bash in the test folder; `prefix` goes before it (e.g. ulimit).
-  int run(const std::string& args, const std::string& prefix = "") const {
-    return g2s::test_support::run_cli(args, dir_, prefix).code;
+  // Runs the CLI in the test folder; files it writes may not grow past `file_size_limit` bytes
+  // (0: no limit).
+  g2s::test_support::CliRun run(const std::vector<std::string>& args,
+                                rlim_t file_size_limit = 0) const {
+    return g2s::test_support::run_cli(dir_, args, {.file_size_limit = file_size_limit});
   }
 
   // Starts the CLI, sends `signal` as soon as `ready()` holds (checked every few ms), returns its
-  // exit code (-1: it finished first).
+  // exit code (-1: it finished first or was killed).
   template <class Ready>
   int interrupt(const std::vector<std::string>& args, int signal, Ready ready) const {
-    const pid_t pid = fork();
-    if (pid == 0) {
-      if (chdir(dir_.c_str()) != 0) _exit(126);
-      std::vector<char*> argv{const_cast<char*>("g2s")};
-      for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-      argv.push_back(nullptr);
-      execv(G2S_CLI_PATH, argv.data());
-      _exit(127);
-    }
-    int status = 0;
+    g2s::test_support::CliChild child(dir_, args);
     while (!ready()) {
-      if (waitpid(pid, &status, WNOHANG) == pid) return -1;
+      if (child.ended()) return -1;
       std::this_thread::sleep_for(std::chrono::milliseconds(3));
     }
-    kill(pid, signal);
-    waitpid(pid, &status, 0);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 1000 + WTERMSIG(status);
+    child.send(signal);
+    return child.wait().code;
   }
 
   std::size_t files_in(const fs::path& folder) const {
@@ -88,38 +75,35 @@ class PipelineFaults : public ::testing::Test {
     return found;
   }
 
-  static std::string read(const fs::path& file) {
-    std::ifstream in(file, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  }
-
   g2s::test_support::TempFolder folder_{"g2s-faults"};
   const fs::path dir_ = folder_.path();
 };
 
-// ulimit -f counts 1024-byte blocks; SIGXFSZ is ignored so the write fails with EFBIG instead.
-const std::string kSmallDisk = "trap \"\" XFSZ; ulimit -f 256;";
+// A disk with room for 256 KiB per file.
+constexpr rlim_t kSmallDisk = 256 * 1024;
 
 TEST_F(PipelineFaults, FullDiskWhileWritingTheTileStore) {
   make_cloud(200000);  // a 5.6 MB store
-  EXPECT_EQ(run("tile cloud.ply s.store", kSmallDisk), 4);
+  const g2s::test_support::CliRun tile = run({"tile", "cloud.ply", "s.store"}, kSmallDisk);
+  EXPECT_EQ(tile.code, 4) << tile.err;
   EXPECT_FALSE(fs::exists(dir_ / "s.store"));
   EXPECT_TRUE(temporaries().empty());
-  EXPECT_NE(read(dir_ / "cli-stderr.txt").find("s.store"), std::string::npos);
+  EXPECT_NE(tile.err.find("s.store"), std::string::npos) << tile.err;
   // g2s mesh fails at its temporary store and leaves nothing either.
-  EXPECT_EQ(run("mesh cloud.ply -o out.stl", kSmallDisk), 4);
+  EXPECT_EQ(run({"mesh", "cloud.ply", "-o", "out.stl"}, kSmallDisk).code, 4);
   EXPECT_FALSE(fs::exists(dir_ / "out.stl"));
   EXPECT_TRUE(temporaries().empty());
 }
 
 TEST_F(PipelineFaults, FullDiskWhileWritingTheMesh) {
   make_cloud(60000);  // 120k triangles: a 6 MB STL, from a 1.7 MB store
-  ASSERT_EQ(run("tile cloud.ply s.store --tile-points 20000 -q"), 0);
-  ASSERT_EQ(run("grow s.store -q"), 0);
-  EXPECT_EQ(run("stitch s.store -o out.stl", "trap \"\" XFSZ; ulimit -f 2048;"), 4);
+  ASSERT_EQ(run({"tile", "cloud.ply", "s.store", "--tile-points", "20000", "-q"}).code, 0);
+  ASSERT_EQ(run({"grow", "s.store", "-q"}).code, 0);
+  const g2s::test_support::CliRun stitch = run({"stitch", "s.store", "-o", "out.stl"}, 2048 * 1024);
+  EXPECT_EQ(stitch.code, 4) << stitch.err;
   EXPECT_FALSE(fs::exists(dir_ / "out.stl"));
   EXPECT_TRUE(temporaries().empty());
-  EXPECT_NE(read(dir_ / "cli-stderr.txt").find("out.stl"), std::string::npos);
+  EXPECT_NE(stitch.err.find("out.stl"), std::string::npos) << stitch.err;
 }
 
 TEST_F(PipelineFaults, InterruptedStagesLeaveNothingAndGrowResumes) {
@@ -147,7 +131,7 @@ TEST_F(PipelineFaults, InterruptedStagesLeaveNothingAndGrowResumes) {
   EXPECT_FALSE(fs::exists(dir_ / "m.stl"));
   EXPECT_TRUE(temporaries().empty());
 
-  ASSERT_EQ(run("tile cloud.ply s.store --tile-points 50000 -q"), 0);
+  ASSERT_EQ(run({"tile", "cloud.ply", "s.store", "--tile-points", "50000", "-q"}).code, 0);
   // grow, one thread: stopped after its first tile; finished tiles stay and are not grown again.
   const fs::path grown = dir_ / "s.store.grown";
   EXPECT_EQ(
@@ -156,10 +140,10 @@ TEST_F(PipelineFaults, InterruptedStagesLeaveNothingAndGrowResumes) {
   EXPECT_TRUE(temporaries().empty());
   const std::size_t kept = files_in(grown);
   EXPECT_GT(kept, 0u);
-  ASSERT_EQ(run("grow s.store"), 0);
-  EXPECT_NE(read(dir_ / "cli-stderr.txt").find(fmt::format("({} already there)", kept)),
-            std::string::npos)
-      << read(dir_ / "cli-stderr.txt");
+  const g2s::test_support::CliRun regrow = run({"grow", "s.store"});
+  ASSERT_EQ(regrow.code, 0) << regrow.err;
+  EXPECT_NE(regrow.err.find(fmt::format("({} already there)", kept)), std::string::npos)
+      << regrow.err;
   // stitch: stopped while it writes the mesh, nothing is left; run again, it gives the mesh of
   // one g2s mesh run.
   const int code = interrupt({"stitch", "s.store", "-o", "s.stl"}, SIGTERM, writing);
@@ -168,9 +152,10 @@ TEST_F(PipelineFaults, InterruptedStagesLeaveNothingAndGrowResumes) {
     EXPECT_FALSE(fs::exists(dir_ / "s.stl"));
   }
   EXPECT_TRUE(temporaries().empty());
-  ASSERT_EQ(run("stitch s.store -o s.stl -q"), 0);
-  ASSERT_EQ(run("mesh cloud.ply -o m.stl --tile-points 50000 -q"), 0);
-  EXPECT_TRUE(read(dir_ / "s.stl") == read(dir_ / "m.stl"));
+  ASSERT_EQ(run({"stitch", "s.store", "-o", "s.stl", "-q"}).code, 0);
+  ASSERT_EQ(run({"mesh", "cloud.ply", "-o", "m.stl", "--tile-points", "50000", "-q"}).code, 0);
+  EXPECT_TRUE(g2s::test_support::file_bytes(dir_ / "s.stl") ==
+              g2s::test_support::file_bytes(dir_ / "m.stl"));
 }
 
 }  // namespace

@@ -38,8 +38,8 @@ class PipelineMemory : public ::testing::Test {
   PipelineMemory() : dir_("g2s-memory") {}
 
   // Runs g2s with `args` in the test folder; returns the exit code, stdout in `out`.
-  int run(const std::string& args, std::string* out = nullptr) {
-    last_ = g2s::test_support::run_cli(args, dir_.path());
+  int run(const std::vector<std::string>& args, std::string* out = nullptr) {
+    last_ = g2s::test_support::run_cli(dir_.path(), args);
     if (out) *out = last_.out;
     return last_.code;
   }
@@ -62,9 +62,11 @@ TEST_F(PipelineMemory, PeakStaysUnderTheBudgetAndTheStitcherHoldsOnlyItsFront) {
   const double points[2] = {400e3, 1600e3};
   for (int k = 0; k < 2; ++k) {
     const std::string cloud = std::string("torus-") + sizes[k] + ".ply";
-    ASSERT_EQ(run(std::string("synth torus -n ") + sizes[k] + " -o " + cloud), 0);
+    ASSERT_EQ(run({"synth", "torus", "-n", sizes[k], "-o", cloud}), 0);
     std::string json;
-    ASSERT_EQ(run("mesh " + cloud + " -o mesh.stl --memory 96M --threads 2 --json", &json), 0)
+    ASSERT_EQ(run({"mesh", cloud, "-o", "mesh.stl", "--memory", "96M", "--threads", "2", "--json"},
+                  &json),
+              0)
         << stderr_text();
     const double peak = number(json, "peak_rss_mb");
     live[k] = number(json, "peak_live_points");
@@ -77,7 +79,7 @@ TEST_F(PipelineMemory, PeakStaysUnderTheBudgetAndTheStitcherHoldsOnlyItsFront) {
     EXPECT_LT(live[k], 0.25 * points[k]);
     EXPECT_EQ(number(json, "seam_triangles_dropped"), 0);
     EXPECT_EQ(number(json, "vertices_unjudged"), 0);
-    ASSERT_EQ(run("stats mesh.stl --json", &json), 0);
+    ASSERT_EQ(run({"stats", "mesh.stl", "--json"}, &json), 0);
     EXPECT_EQ(number(json, "non_manifold_edges"), 0);
     EXPECT_EQ(number(json, "non_manifold_vertices"), 0);
     EXPECT_EQ(number(json, "orientation_conflicts"), 0);
@@ -90,8 +92,8 @@ TEST_F(PipelineMemory, PeakStaysUnderTheBudgetAndTheStitcherHoldsOnlyItsFront) {
 }
 
 TEST_F(PipelineMemory, ABudgetTooSmallIsRefused) {
-  ASSERT_EQ(run("synth sphere -n 1000 -o sphere.ply"), 0);
-  EXPECT_EQ(run("mesh sphere.ply -o mesh.stl --memory 8M --threads 2"), 2);
+  ASSERT_EQ(run({"synth", "sphere", "-n", "1000", "-o", "sphere.ply"}), 0);
+  EXPECT_EQ(run({"mesh", "sphere.ply", "-o", "mesh.stl", "--memory", "8M", "--threads", "2"}), 2);
   EXPECT_NE(stderr_text().find("--memory 8 MB is too small"), std::string::npos) << stderr_text();
   EXPECT_FALSE(std::filesystem::exists(dir_.path() / "mesh.stl"));
 }

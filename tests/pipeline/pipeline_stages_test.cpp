@@ -2,6 +2,7 @@
 // them, give the same bytes as g2s mesh, with any thread count; growth files refuse to be
 // stitched when truncated, corrupt or from another store; each triangle is kept by one tile
 // only; seams placed through sharp edges, a thin plate and a hole close cleanly.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -9,9 +10,9 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
@@ -24,6 +25,7 @@
 namespace {
 
 namespace fs = std::filesystem;
+using g2s::test_support::file_bytes;
 
 class Stages : public ::testing::Test {
  protected:
@@ -37,14 +39,10 @@ class Stages : public ::testing::Test {
   }
 
   // Runs the CLI in the test folder; returns its exit code, stderr in `err`.
-  int run(const std::string& args, std::string* err = nullptr) const {
-    const g2s::test_support::CliRun r = g2s::test_support::run_cli(args, dir_);
+  int run(const std::vector<std::string>& args, std::string* err = nullptr) const {
+    const g2s::test_support::CliRun r = g2s::test_support::run_cli(dir_, args);
     if (err) *err = r.err;
     return r.code;
-  }
-  static std::string read(const fs::path& file) {
-    std::ifstream in(file, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   }
 
   g2s::test_support::TempFolder folder_{"g2s-stages"};
@@ -53,25 +51,29 @@ class Stages : public ::testing::Test {
 };
 
 TEST_F(Stages, SeparateProcessesGiveTheBytesOfOneMeshRunForAnyThreadCount) {
-  ASSERT_EQ(run("mesh torus.ply -o one.stl --tile-points 2000 --threads 1 -q"), 0);
-  ASSERT_EQ(run("mesh torus.ply -o two.stl --tile-points 2000 --threads 2 -q"), 0);
-  ASSERT_EQ(run("tile torus.ply s.store --tile-points 2000 -q"), 0);
+  ASSERT_EQ(
+      run({"mesh", "torus.ply", "-o", "one.stl", "--tile-points", "2000", "--threads", "1", "-q"}),
+      0);
+  ASSERT_EQ(
+      run({"mesh", "torus.ply", "-o", "two.stl", "--tile-points", "2000", "--threads", "2", "-q"}),
+      0);
+  ASSERT_EQ(run({"tile", "torus.ply", "s.store", "--tile-points", "2000", "-q"}), 0);
   const g2s::TileStore store(dir_ / "s.store");
   const std::size_t tiles = store.tiles().size();
   ASSERT_GE(tiles, 10u);
   const std::size_t half = tiles / 2;
-  ASSERT_EQ(run("grow s.store --tiles 0-" + std::to_string(half - 1) + " --threads 1 -q"), 0);
   ASSERT_EQ(
-      run("grow s.store --tiles " + std::to_string(half) + "-" + std::to_string(tiles - 1) + " -q"),
+      run({"grow", "s.store", "--tiles", fmt::format("0-{}", half - 1), "--threads", "1", "-q"}),
       0);
-  ASSERT_EQ(run("stitch s.store -o staged.stl -q"), 0);
-  const std::string one = read(dir_ / "one.stl");
+  ASSERT_EQ(run({"grow", "s.store", "--tiles", fmt::format("{}-{}", half, tiles - 1), "-q"}), 0);
+  ASSERT_EQ(run({"stitch", "s.store", "-o", "staged.stl", "-q"}), 0);
+  const std::string one = file_bytes(dir_ / "one.stl");
   ASSERT_GT(one.size(), 84u);
-  EXPECT_TRUE(one == read(dir_ / "two.stl")) << "1 and 2 threads differ";
-  EXPECT_TRUE(one == read(dir_ / "staged.stl")) << "separate stages differ from g2s mesh";
+  EXPECT_TRUE(one == file_bytes(dir_ / "two.stl")) << "1 and 2 threads differ";
+  EXPECT_TRUE(one == file_bytes(dir_ / "staged.stl")) << "separate stages differ from g2s mesh";
   // Growing again finds every tile done: nothing changes.
   std::string err;
-  ASSERT_EQ(run("grow s.store", &err), 0);
+  ASSERT_EQ(run({"grow", "s.store"}, &err), 0);
   EXPECT_NE(err.find("(" + std::to_string(tiles) + " already there)"), std::string::npos) << err;
 }
 
@@ -79,52 +81,52 @@ TEST_F(Stages, GnuParallelDrivesTheGrowStage) {
   if (std::system("command -v parallel > /dev/null 2>&1") != 0) {
     GTEST_SKIP() << "GNU parallel is not installed (scripts/install-deps.sh installs it)";
   }
-  ASSERT_EQ(run("mesh torus.ply -o one.stl --tile-points 2000 -q"), 0);
-  ASSERT_EQ(run("tile torus.ply s.store --tile-points 2000 -q"), 0);
+  ASSERT_EQ(run({"mesh", "torus.ply", "-o", "one.stl", "--tile-points", "2000", "-q"}), 0);
+  ASSERT_EQ(run({"tile", "torus.ply", "s.store", "--tile-points", "2000", "-q"}), 0);
   const std::size_t tiles = g2s::TileStore(dir_ / "s.store").tiles().size();
   // One job per tile, up to 4 at once, exactly as docs/pipeline.md shows.
   const std::string command = "cd \"" + dir_.string() + "\" && seq 0 " + std::to_string(tiles - 1) +
                               " | parallel -j4 --halt now,fail=1 \"" + G2S_CLI_PATH +
                               "\" grow s.store --tiles {} --threads 1 -q";
   ASSERT_EQ(std::system(command.c_str()), 0);
-  ASSERT_EQ(run("stitch s.store -o parallel.stl -q"), 0);
-  EXPECT_TRUE(read(dir_ / "one.stl") == read(dir_ / "parallel.stl"))
+  ASSERT_EQ(run({"stitch", "s.store", "-o", "parallel.stl", "-q"}), 0);
+  EXPECT_TRUE(file_bytes(dir_ / "one.stl") == file_bytes(dir_ / "parallel.stl"))
       << "GNU parallel stages differ from g2s mesh";
 }
 
 TEST_F(Stages, StitchRefusesMissingCorruptTruncatedOrForeignGrowths) {
-  ASSERT_EQ(run("tile torus.ply s.store --tile-points 4000 -q"), 0);
+  ASSERT_EQ(run({"tile", "torus.ply", "s.store", "--tile-points", "4000", "-q"}), 0);
   std::string err;
-  EXPECT_EQ(run("stitch s.store -o out.stl", &err), 3);
+  EXPECT_EQ(run({"stitch", "s.store", "-o", "out.stl"}, &err), 3);
   EXPECT_NE(err.find("was the tile grown"), std::string::npos) << err;
-  ASSERT_EQ(run("grow s.store -q"), 0);
+  ASSERT_EQ(run({"grow", "s.store", "-q"}), 0);
   const fs::path growth = dir_ / "s.store.grown" / "tile-000001.g2sgrow";
-  const std::string good = read(growth);
+  const std::string good = file_bytes(growth);
   auto write = [&](const std::string& bytes) {
     std::ofstream(growth, std::ios::binary | std::ios::trunc) << bytes;
   };
   std::string bad = good;
   bad[bad.size() / 2] ^= 0x10;
   write(bad);
-  EXPECT_EQ(run("stitch s.store -o out.stl", &err), 3);
+  EXPECT_EQ(run({"stitch", "s.store", "-o", "out.stl"}, &err), 3);
   EXPECT_NE(err.find("triangle checksum mismatch"), std::string::npos) << err;
   bad = good;
   bad[20] ^= 0x01;  // inside the header
   write(bad);
-  EXPECT_EQ(run("stitch s.store -o out.stl", &err), 3);
+  EXPECT_EQ(run({"stitch", "s.store", "-o", "out.stl"}, &err), 3);
   EXPECT_NE(err.find("header checksum mismatch"), std::string::npos) << err;
   write(good.substr(0, good.size() - 7));
-  EXPECT_EQ(run("stitch s.store -o out.stl", &err), 3);
+  EXPECT_EQ(run({"stitch", "s.store", "-o", "out.stl"}, &err), 3);
   EXPECT_NE(err.find("truncated"), std::string::npos) << err;
   EXPECT_FALSE(fs::exists(dir_ / "out.stl"));
   // Growths of another store (other tiles) are refused, and the grow stage redoes them.
   write(good);
-  ASSERT_EQ(run("tile torus.ply other.store --tile-points 3000 -q"), 0);
-  EXPECT_EQ(run("stitch other.store --grown s.store.grown -o out.stl", &err), 3);
+  ASSERT_EQ(run({"tile", "torus.ply", "other.store", "--tile-points", "3000", "-q"}), 0);
+  EXPECT_EQ(run({"stitch", "other.store", "--grown", "s.store.grown", "-o", "out.stl"}, &err), 3);
   EXPECT_NE(err.find("different tile store"), std::string::npos) << err;
   write(good.substr(0, 50));
-  ASSERT_EQ(run("grow s.store", &err), 0);
-  EXPECT_TRUE(read(growth) == good) << "a tile grown again gives other bytes";
+  ASSERT_EQ(run({"grow", "s.store"}, &err), 0);
+  EXPECT_TRUE(file_bytes(growth) == good) << "a tile grown again gives other bytes";
 }
 
 // Tile growths: every kept triangle has all its corners in its own tile, so no triangle is kept

@@ -4,15 +4,14 @@
 // version cut the cloud differently for each thread count.
 #include <fmt/core.h>
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <string>
 
 #include "g2s/pipeline.hpp"
 #include "g2s/synth.hpp"
 #include "g2s/tile_store.hpp"
+#include "support/cli.hpp"
 #include "support/temp_folder.hpp"
 
 namespace {
@@ -26,12 +25,10 @@ class ThreadCount : public ::testing::Test {
                    std::size_t* tiles) const {
     const fs::path out = dir_ / fmt::format("t{}.stl", threads);
     const fs::path store = dir_ / fmt::format("t{}.store", threads);
-    const std::string command = fmt::format(
-        "\"{}\" mesh \"{}\" -o \"{}\" --keep-store \"{}\" --memory {} --threads {} -q "
-        "--no-stats",
-        G2S_CLI_PATH, cloud.string(), out.string(), store.string(), memory, threads);
-    const int status = std::system(command.c_str());
-    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << command;
+    const g2s::test_support::CliRun r = g2s::test_support::run_cli(
+        dir_, {"mesh", cloud.string(), "-o", out.string(), "--keep-store", store.string(),
+               "--memory", memory, "--threads", std::to_string(threads), "-q", "--no-stats"});
+    EXPECT_EQ(r.code, 0) << r.err;
     *tiles = g2s::TileStore(store).tiles().size();
     fs::remove(store);
     return g2s::test_support::file_bytes(out);
@@ -60,10 +57,8 @@ class ThreadCount : public ::testing::Test {
 };
 
 TEST_F(ThreadCount, SameBytesOnARealScanAtSeveralBudgets) {
-  const char* env = std::getenv("G2S_DATA_DIR");
-  const fs::path data = env && *env ? fs::path(env) : fs::path(G2S_DEFAULT_DATA_DIR);
-  const fs::path cloud = data / "raw-bunny.ply";
-  if (!fs::exists(cloud)) GTEST_SKIP() << "no " << cloud << " (set G2S_DATA_DIR)";
+  const fs::path cloud = g2s::test_support::data_dir() / "raw-bunny.ply";
+  G2S_SKIP_WITHOUT_DATA(cloud);
   expect_same_bytes(cloud, {"64M", "100M"}, 8);
 }
 

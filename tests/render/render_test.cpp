@@ -11,8 +11,6 @@
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -20,6 +18,7 @@
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
 #include "support/cli.hpp"
+#include "support/temp_folder.hpp"
 
 namespace {
 
@@ -356,27 +355,25 @@ TEST(Render, PngOfAManyColouredImageRoundTrips) {
 }
 
 TEST(Render, CommandLine) {
-  const auto dir =
-      std::filesystem::temp_directory_path() /
-      ("g2s_render_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
-  std::filesystem::create_directories(dir);
+  const g2s::test_support::TempFolder folder("g2s-render-cli");
+  const std::filesystem::path& dir = folder.path();
   const g2s::IndexedMesh mesh = tetrahedron();
   g2s::write_mesh(dir / "tet.ply", mesh.xyz, mesh.triangles, g2s::MeshFormat::ply_binary);
-  auto run = [&](const std::string& args) { return g2s::test_support::run_cli(args, dir).code; };
-  const std::string in = " \"" + (dir / "tet.ply").string() + "\"";
-  const std::string out = " -o \"" + (dir / "tet.png").string() + "\"";
-  ASSERT_EQ(run("render" + in + out + " --size 120x90 --view 45,30 --up y"), 0);
-  std::ifstream file(dir / "tet.png", std::ios::binary);
-  const Bytes png((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  const g2s::Image image = decode_png(png);
+  const std::string in = (dir / "tet.ply").string();
+  const std::string out = (dir / "tet.png").string();
+  auto run = [&](const std::vector<std::string>& args, int code) {
+    g2s::test_support::cli_output(dir, args, code);
+  };
+  run({"render", in, "-o", out, "--size", "120x90", "--view", "45,30", "--up", "y"}, 0);
+  const std::string png = g2s::test_support::file_bytes(dir / "tet.png");
+  const g2s::Image image = decode_png(Bytes(png.begin(), png.end()));
   EXPECT_EQ(image.width, 120);
   EXPECT_EQ(image.height, 90);
   EXPECT_GT(census(image).blue, 1000);
-  EXPECT_EQ(run("render" + in + out + " --size 120"), 2);
-  EXPECT_EQ(run("render" + in + out + " --view 10,95"), 2);
-  EXPECT_EQ(run("render" + in + out + " --up w"), 2);
-  EXPECT_EQ(run("render \"" + (dir / "missing.ply").string() + "\"" + out), 3);
-  std::filesystem::remove_all(dir);
+  run({"render", in, "-o", out, "--size", "120"}, 2);
+  run({"render", in, "-o", out, "--view", "10,95"}, 2);
+  run({"render", in, "-o", out, "--up", "w"}, 2);
+  run({"render", (dir / "missing.ply").string(), "-o", out}, 3);
 }
 
 }  // namespace

@@ -5,14 +5,13 @@
 
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <string>
 
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
 #include "g2s/stats.hpp"
 #include "support/cli.hpp"
+#include "support/temp_folder.hpp"
 
 namespace {
 
@@ -53,19 +52,16 @@ TEST(LargestComponent, TiesGoToTheFirstPieceAndEmptyStaysEmpty) {
 }
 
 TEST(LargestComponent, CommandLine) {
-  const auto dir =
-      std::filesystem::temp_directory_path() /
-      ("g2s_largest_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
-  std::filesystem::create_directories(dir);
+  const g2s::test_support::TempFolder folder("g2s-largest-cli");
+  const std::filesystem::path& dir = folder.path();
   const g2s::IndexedMesh mesh = three_pieces();
   g2s::write_mesh(dir / "pieces.ply", mesh.xyz, mesh.triangles, g2s::MeshFormat::ply_binary);
   const g2s::test_support::CliRun run = g2s::test_support::run_cli(
-      "stats \"" + (dir / "pieces.ply").string() + "\" --largest-component --json", dir);
+      dir, {"stats", (dir / "pieces.ply").string(), "--largest-component", "--json"});
   ASSERT_EQ(run.code, 0) << run.err;
   const std::string& json = run.out;
   EXPECT_NE(json.find("\"triangles\": 4,"), std::string::npos) << json;
   EXPECT_NE(json.find("\"components\": 1"), std::string::npos) << json;
-  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

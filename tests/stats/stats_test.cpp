@@ -21,6 +21,7 @@
 
 #include "g2s/error.hpp"
 #include "support/cli.hpp"
+#include "support/temp_folder.hpp"
 
 namespace {
 
@@ -532,16 +533,8 @@ TEST(Stats, TextIsAligned) {
 
 // The command line: `g2s stats` on an ASCII STL written here (STL is a triangle soup, so this
 // also checks welding through the reader).
-class StatsCli : public ::testing::Test {
+class StatsCli : public g2s::test_support::FolderTest {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("g2s_stats_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-            "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-
   std::filesystem::path write_tetrahedron_stl() {
     const IndexedMesh mesh = tetrahedron();
     const auto path = dir_ / "tet.stl";
@@ -559,24 +552,19 @@ class StatsCli : public ::testing::Test {
     return path;
   }
 
-  // Runs the CLI with `args`; returns its exit code and fills `output` with its stdout.
-  int run(const std::string& args, std::string& output) {
-    const g2s::test_support::CliRun r = g2s::test_support::run_cli(args, dir_);
-    output = r.out + r.err;
-    return r.code;
+  g2s::test_support::CliRun run(const std::vector<std::string>& args) const {
+    return g2s::test_support::run_cli(dir_, args);
   }
-
-  std::filesystem::path dir_;
 };
 
 TEST_F(StatsCli, JsonOnStl) {
   const auto stl = write_tetrahedron_stl();
   const auto xyz = dir_ / "cloud.xyz";
   std::ofstream(xyz) << "0 0 0\n1 0 0\n5 5 5\n0 1 0\n";
-  std::string output;
-  ASSERT_EQ(run("stats \"" + stl.string() + "\" --json --points \"" + xyz.string() + "\"", output),
-            0)
-      << output;
+  const g2s::test_support::CliRun r =
+      run({"stats", stl.string(), "--json", "--points", xyz.string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string& output = r.out;
   EXPECT_NE(output.find("\"triangles\": 4,"), std::string::npos) << output;
   EXPECT_NE(output.find("\"vertices\": 4,"), std::string::npos) << output;
   EXPECT_NE(output.find("\"holes\": 0,"), std::string::npos) << output;
@@ -586,12 +574,14 @@ TEST_F(StatsCli, JsonOnStl) {
 
 TEST_F(StatsCli, TextAndErrors) {
   const auto stl = write_tetrahedron_stl();
-  std::string output;
-  ASSERT_EQ(run("stats \"" + stl.string() + "\"", output), 0) << output;
-  EXPECT_NE(output.find("components"), std::string::npos) << output;
-  EXPECT_EQ(output.find('{'), std::string::npos) << output;
-  EXPECT_EQ(run("stats \"" + (dir_ / "missing.stl").string() + "\"", output), 3) << output;
-  EXPECT_EQ(run("stats", output), 2) << output;
+  const g2s::test_support::CliRun text = run({"stats", stl.string()});
+  ASSERT_EQ(text.code, 0) << text.err;
+  EXPECT_NE(text.out.find("components"), std::string::npos) << text.out;
+  EXPECT_EQ(text.out.find('{'), std::string::npos) << text.out;
+  const g2s::test_support::CliRun missing = run({"stats", (dir_ / "missing.stl").string()});
+  EXPECT_EQ(missing.code, 3) << missing.err;
+  const g2s::test_support::CliRun no_mesh = run({"stats"});
+  EXPECT_EQ(no_mesh.code, 2) << no_mesh.err;
 }
 
 }  // namespace

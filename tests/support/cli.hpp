@@ -1,47 +1,179 @@
-// Test support shared by every test file: the `g2s` CLI run as users run it, the real scans'
-// folder, and numbers read from the CLI's JSON where a missing key fails the test.
+// Test support shared by every test file: the `g2s` CLI (G2S_CLI_PATH) run as users run it, in a
+// child process with a deadline, the real scans' folder, and numbers read from the CLI's JSON
+// where a missing key fails the test.
 #pragma once
 
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
+#include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <limits>
 #include <string>
+#include <vector>
+
+#include "support/temp_folder.hpp"
 
 namespace g2s::test_support {
 
-// What a CLI run gave: its exit code (-1 when killed by a signal), stdout and stderr.
+// What a CLI run gave: its exit code (-1 when killed by a signal or the deadline), stdout and
+// stderr (with why the run was killed, if it was).
 struct CliRun {
   int code = -1;
   std::string out;
   std::string err;
 };
 
-inline std::string read_text(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+struct CliOptions {
+  // A run still going after this many seconds is killed and fails the test as a hang.
+  double seconds = 600.0;
+  // Run as user nobody through setpriv: a root test run checking permissions (the folder and
+  // the files the run reads must be open to others).
+  bool as_nobody = false;
+  // Files the run writes may not grow past this many bytes (0: no limit). SIGXFSZ is ignored,
+  // so writes fail with EFBIG, as on a full disk.
+  rlim_t file_size_limit = 0;
+};
+
+// `g2s ARGS` started in a child process whose working folder is `dir`. Its stdout and stderr go
+// to unnamed temporary files, so the folder holds only what g2s writes there.
+//
+// g2s is started through `timeout --foreground 0` (no time limit), which forks it from a small
+// process and passes signals and the exit status through, as a shell does. Started straight from
+// this process, g2s would report this process's memory as its own peak: Linux carries
+// ru_maxrss over exec from the memory of the process that forked it.
+class CliChild {
+ public:
+  CliChild(const std::filesystem::path& dir, const std::vector<std::string>& args,
+           const CliOptions& options = {})
+      : seconds_(options.seconds), out_(std::tmpfile()), err_(std::tmpfile()) {
+    if (out_ == nullptr || err_ == nullptr) return;
+    // Everything the child needs is made before fork(): the child of a threaded process may
+    // not allocate.
+    std::vector<char*> argv;
+    if (options.as_nobody) {
+      for (const char* a : {"setpriv", "--reuid=nobody", "--regid=nogroup", "--clear-groups"}) {
+        argv.push_back(const_cast<char*>(a));
+      }
+    }
+    for (const char* a : {"/usr/bin/timeout", "--foreground", "0", G2S_CLI_PATH}) {
+      argv.push_back(const_cast<char*>(a));
+    }
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    const char* program = options.as_nobody ? "/usr/bin/setpriv" : "/usr/bin/timeout";
+    const int out = ::fileno(out_), err = ::fileno(err_);
+    const rlimit limit{options.file_size_limit, options.file_size_limit};
+    pid_ = ::fork();
+    if (pid_ > 0) ::setpgid(pid_, pid_);  // here too, so the group exists before any kill
+    if (pid_ != 0) return;
+    // A group of its own, so that a run past its deadline is killed with g2s.
+    if (::setpgid(0, 0) != 0 || ::chdir(dir.c_str()) != 0 || ::dup2(out, STDOUT_FILENO) < 0 ||
+        ::dup2(err, STDERR_FILENO) < 0) {
+      ::_exit(127);
+    }
+    if (options.file_size_limit > 0) {
+      ::signal(SIGXFSZ, SIG_IGN);
+      if (::setrlimit(RLIMIT_FSIZE, &limit) != 0) ::_exit(127);
+    }
+    ::execv(program, argv.data());
+    ::_exit(127);
+  }
+  ~CliChild() {
+    if (pid_ > 0 && !ended_) {
+      ::kill(-pid_, SIGKILL);
+      ::waitpid(pid_, &status_, 0);
+    }
+    if (out_) std::fclose(out_);
+    if (err_) std::fclose(err_);
+  }
+  CliChild(const CliChild&) = delete;
+  CliChild& operator=(const CliChild&) = delete;
+
+  // Whether the run has ended (or never started); does not wait.
+  bool ended() {
+    if (!ended_ && (pid_ <= 0 || ::waitpid(pid_, &status_, WNOHANG) == pid_)) ended_ = true;
+    return ended_;
+  }
+  void send(int signal_number) const {
+    if (pid_ > 0 && !ended_) ::kill(pid_, signal_number);
+  }
+
+  // Waits for the end (a run past the deadline is killed and fails the test) and gives its exit
+  // code and output.
+  CliRun wait() {
+    if (pid_ <= 0) {
+      ADD_FAILURE() << "could not start g2s";
+      return {-1, "", "could not start g2s"};
+    }
+    const auto deadline =
+        std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds_);
+    std::string why;
+    while (!ended()) {
+      if (std::chrono::steady_clock::now() > deadline) {
+        ::kill(-pid_, SIGKILL);
+        ::waitpid(pid_, &status_, 0);
+        ended_ = true;
+        ADD_FAILURE() << "g2s did not finish within " << seconds_ << " s (hang?)";
+        why = "\n[killed: did not finish within " + std::to_string(seconds_) + " s]";
+      }
+      ::usleep(2000);
+    }
+    CliRun run{WIFEXITED(status_) && why.empty() ? WEXITSTATUS(status_) : -1, contents(out_),
+               contents(err_) + why};
+    if (WIFSIGNALED(status_) && why.empty()) {
+      run.err += "\n[killed by signal " + std::to_string(WTERMSIG(status_)) + "]";
+    }
+    return run;
+  }
+
+ private:
+  static std::string contents(std::FILE* file) {
+    std::string text;
+    std::rewind(file);
+    char buffer[65536];
+    for (std::size_t got; (got = std::fread(buffer, 1, sizeof buffer, file)) > 0;) {
+      text.append(buffer, got);
+    }
+    return text;
+  }
+
+  double seconds_;
+  std::FILE* out_;
+  std::FILE* err_;
+  pid_t pid_ = -1;
+  int status_ = 0;
+  bool ended_ = false;
+};
+
+// Runs `g2s ARGS` in folder `dir` to its end (see CliChild).
+inline CliRun run_cli(const std::filesystem::path& dir, const std::vector<std::string>& args,
+                      const CliOptions& options = {}) {
+  return CliChild(dir, args, options).wait();
 }
 
-// Runs `g2s ARGS` through bash in folder `dir` (ARGS is shell text: quote paths). `prefix` runs
-// first in the same bash (e.g. ulimit -f); `wrapper` goes in front of the CLI's path (e.g. setpriv
-// to run it as another user). stdout and stderr are kept in dir/cli-stdout.txt and
-// dir/cli-stderr.txt.
-inline CliRun run_cli(const std::string& args, const std::filesystem::path& dir,
-                      const std::string& prefix = "", const std::string& wrapper = "") {
-  const std::string command = "cd \"" + dir.string() + "\" && bash -c '" + prefix + " exec " +
-                              wrapper + " \"" + G2S_CLI_PATH + "\" " + args +
-                              "' > cli-stdout.txt 2> cli-stderr.txt";
-  const int status = std::system(command.c_str());
-  CliRun run;
-  run.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  run.out = read_text(dir / "cli-stdout.txt");
-  run.err = read_text(dir / "cli-stderr.txt");
-  return run;
+// Runs `g2s ARGS` in folder `dir`, expects exit code `code`, and gives stdout and stderr
+// together.
+inline std::string cli_output(const std::filesystem::path& dir,
+                              const std::vector<std::string>& args, int code) {
+  const CliRun run = run_cli(dir, args);
+  EXPECT_EQ(run.code, code) << run.err;
+  return run.out + run.err;
 }
+
+// A fixture whose test runs the CLI in a fresh folder of its own (dir_).
+class CliTest : public FolderTest {
+ protected:
+  // The CLI run in the test's folder, expected to exit with `code`; stdout and stderr together.
+  std::string run(const std::vector<std::string>& args, int code) const {
+    return cli_output(dir_, args, code);
+  }
+};
 
 // The real scans: $G2S_DATA_DIR, or ../shared/data beside the repository.
 inline std::filesystem::path data_dir() {

@@ -1,8 +1,10 @@
 // Test support: a fresh folder per test (mkdtemp, so parallel tests never share one), removed
-// with everything in it when the test ends, and a file's bytes read whole. Permissions a test took
+// with everything in it when the test ends, a fixture that holds one, and a file's bytes read
+// whole. Permissions a test took
 // away (a read-only folder, an unreadable file) are given back first, so the removal always works.
 #pragma once
 
+#include <gtest/gtest.h>
 #include <stdlib.h>
 
 #include <filesystem>
@@ -43,6 +45,16 @@ class TempFolder {
 
  private:
   std::filesystem::path path_;
+};
+
+// A fixture whose test has a fresh folder, dir_, and writes files there with write().
+class FolderTest : public ::testing::Test {
+ protected:
+  std::filesystem::path write(const std::string& name, std::string_view bytes) const {
+    return folder_.write(name, bytes);
+  }
+  TempFolder folder_{"g2s-test"};
+  const std::filesystem::path dir_ = folder_.path();
 };
 
 // The bytes of a file (empty when it cannot be read).

@@ -18,6 +18,7 @@
 #include "g2s/io.hpp"
 #include "g2s/synth.hpp"
 #include "support/cli.hpp"
+#include "support/temp_folder.hpp"
 
 namespace {
 
@@ -147,26 +148,7 @@ TEST(SynthPerturb, RejectsBadOptionsAndCloudsWithoutASpacing) {
   EXPECT_EQ(expect_error(plane, options), 0);
 }
 
-class SynthPerturbFiles : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ =
-        std::filesystem::temp_directory_path() /
-        ("g2s_perturb_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-         "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-
-  // Runs the CLI with `args`; returns its exit code and fills `output` with stdout and stderr.
-  int run(const std::string& args, std::string& output) {
-    const g2s::test_support::CliRun r = g2s::test_support::run_cli(args, dir_);
-    output = r.out + r.err;
-    return r.code;
-  }
-
-  std::filesystem::path dir_;
-};
+using SynthPerturbFiles = g2s::test_support::CliTest;
 
 // `g2s synth --from` writes perturb_cloud's points as float, and refuses to mix a SHAPE in.
 TEST_F(SynthPerturbFiles, CommandLine) {
@@ -181,12 +163,9 @@ TEST_F(SynthPerturbFiles, CommandLine) {
                static_cast<float>(grid.xyz[3 * i + 2]));
   writer.finish();
   const auto output_path = dir_ / "out.ply";
-  std::string output;
-  ASSERT_EQ(run("synth --from \"" + input.string() +
-                    "\" --noise 0.2 --outliers 0.1 --seed 9 -o \"" + output_path.string() + "\"",
-                output),
-            0)
-      << output;
+  const std::string output = run({"synth", "--from", input.string(), "--noise", "0.2", "--outliers",
+                                  "0.1", "--seed", "9", "-o", output_path.string()},
+                                 0);
   EXPECT_NE(output.find("900 points + 90 outliers, spacing 0.5,"), std::string::npos) << output;
   PerturbOptions options;
   options.noise = 0.2;
@@ -198,12 +177,11 @@ TEST_F(SynthPerturbFiles, CommandLine) {
   for (std::size_t k = 0; k < expected.xyz.size(); ++k)
     ASSERT_EQ(written.xyz[k], static_cast<double>(static_cast<float>(expected.xyz[k])));
 
-  const std::string out = " -o \"" + (dir_ / "bad.ply").string() + "\"";
-  EXPECT_EQ(run("synth torus --from \"" + input.string() + "\"" + out, output), 2) << output;
-  EXPECT_EQ(run("synth --from \"" + input.string() + "\" -n 100" + out, output), 2) << output;
-  EXPECT_EQ(run("synth --noise 0.1" + out, output), 2) << output;
-  EXPECT_EQ(run("synth --from \"" + (dir_ / "missing.ply").string() + "\"" + out, output), 3)
-      << output;
+  const std::string bad = (dir_ / "bad.ply").string();
+  run({"synth", "torus", "--from", input.string(), "-o", bad}, 2);
+  run({"synth", "--from", input.string(), "-n", "100", "-o", bad}, 2);
+  run({"synth", "--noise", "0.1", "-o", bad}, 2);
+  run({"synth", "--from", (dir_ / "missing.ply").string(), "-o", bad}, 3);
   EXPECT_FALSE(std::filesystem::exists(dir_ / "bad.ply"));
 }
 

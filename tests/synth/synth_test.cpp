@@ -22,6 +22,7 @@
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
 #include "support/cli.hpp"
+#include "support/temp_folder.hpp"
 #include "synth/sampler.hpp"
 
 namespace {
@@ -358,25 +359,7 @@ TEST(Synth, RejectsBadOptions) {
   EXPECT_EQ(code(options), g2s::Exit::ok);
 }
 
-class SynthFiles : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("g2s_synth_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-            "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-
-  // Runs the CLI with `args`; returns its exit code and fills `output` with stdout and stderr.
-  int run(const std::string& args, std::string& output) {
-    const g2s::test_support::CliRun r = g2s::test_support::run_cli(args, dir_);
-    output = r.out + r.err;
-    return r.code;
-  }
-
-  std::filesystem::path dir_;
-};
+using SynthFiles = g2s::test_support::CliTest;
 
 // Streaming in 1M-point chunks writes exactly the in-memory cloud: more than one chunk, with a
 // chunk boundary among the outliers as well.
@@ -396,12 +379,9 @@ TEST_F(SynthFiles, StreamedFileEqualsInMemoryCloud) {
 
 TEST_F(SynthFiles, CommandLine) {
   const auto path = dir_ / "cube.ply";
-  std::string output;
-  ASSERT_EQ(run("synth cube --points 2k --noise 0.1 --outliers 0.01 --seed 5 -o \"" +
-                    path.string() + "\"",
-                output),
-            0)
-      << output;
+  const std::string output = run({"synth", "cube", "--points", "2k", "--noise", "0.1", "--outliers",
+                                  "0.01", "--seed", "5", "-o", path.string()},
+                                 0);
   EXPECT_NE(output.find("2000 points"), std::string::npos) << output;
   EXPECT_NE(output.find(path.filename().string()), std::string::npos) << output;
   SynthOptions options = options_for(SynthShape::cube, 2000, 5);
@@ -409,23 +389,19 @@ TEST_F(SynthFiles, CommandLine) {
   options.outliers = 0.01;
   EXPECT_EQ(g2s::read_points(path).xyz, g2s::make_synthetic_cloud(options).xyz);
 
-  ASSERT_EQ(run("synth sphere -n 1.5k -o \"" + path.string() + "\"", output), 0) << output;
+  run({"synth", "sphere", "-n", "1.5k", "-o", path.string()}, 0);
   EXPECT_EQ(g2s::read_points(path).size(), 1500u);
 
-  const std::string out = " -o \"" + (dir_ / "bad.ply").string() + "\"";
-  EXPECT_EQ(run("synth donut --points 100" + out, output), 2) << output;
-  EXPECT_EQ(run("synth sphere --points 0" + out, output), 2) << output;
-  EXPECT_EQ(run("synth sphere --points 1.5x" + out, output), 2) << output;
-  EXPECT_EQ(run("synth sphere --points 0.5k5" + out, output), 2) << output;
-  EXPECT_EQ(run("synth sphere --points 1.0001k" + out, output), 2) << output;
-  EXPECT_EQ(run("synth sphere --points 100 --noise -1" + out, output), 2) << output;
-  EXPECT_EQ(run("synth sphere --points 100 --outliers -0.5" + out, output), 2) << output;
-  EXPECT_EQ(run("synth sphere --points 100", output), 2) << output;  // no -o
+  const std::string bad = (dir_ / "bad.ply").string();
+  run({"synth", "donut", "--points", "100", "-o", bad}, 2);
+  for (const char* points : {"0", "1.5x", "0.5k5", "1.0001k"}) {
+    run({"synth", "sphere", "--points", points, "-o", bad}, 2);
+  }
+  run({"synth", "sphere", "--points", "100", "--noise", "-1", "-o", bad}, 2);
+  run({"synth", "sphere", "--points", "100", "--outliers", "-0.5", "-o", bad}, 2);
+  run({"synth", "sphere", "--points", "100"}, 2);  // no -o
   EXPECT_FALSE(std::filesystem::exists(dir_ / "bad.ply"));
-  EXPECT_EQ(
-      run("synth sphere --points 100 -o \"" + (dir_ / "missing" / "x.ply").string() + "\"", output),
-      4)
-      << output;
+  run({"synth", "sphere", "--points", "100", "-o", (dir_ / "missing" / "x.ply").string()}, 4);
 }
 
 }  // namespace

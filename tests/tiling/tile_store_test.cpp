@@ -19,9 +19,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <initializer_list>
-#include <iterator>
 #include <limits>
 #include <string>
 #include <string_view>
@@ -42,11 +40,8 @@ namespace {
 namespace fs = std::filesystem;
 using g2s::Exit;
 
-class TileStoreTest : public ::testing::Test {
+class TileStoreTest : public g2s::test_support::FolderTest {
  protected:
-  fs::path write(const std::string& name, std::string_view bytes) {
-    return folder_.write(name, bytes);
-  }
   // Text XYZ with the doubles printed exactly.
   fs::path write_xyz(const std::string& name, const std::vector<double>& xyz) {
     std::string text;
@@ -74,16 +69,10 @@ class TileStoreTest : public ::testing::Test {
     g2s::build_tile_store(input, store, options);
     return store;
   }
-  g2s::test_support::TempFolder folder_{"g2s-tile-store"};
-  const fs::path dir_ = folder_.path();
 };
 
-std::string read_bytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
 using g2s::test_support::expect_error;
+using g2s::test_support::file_bytes;
 
 // Distance to the nearest face of the box that is not on the cloud's bounding box, written
 // out independently of the library's.
@@ -364,14 +353,14 @@ TEST_F(TileStoreTest, LoadBorderIsExactlyThePointsWithinTheDistance) {
 TEST_F(TileStoreTest, BytesAreDeterministicWhateverTheRoundsAndThreads) {
   const fs::path input = synthetic("cube.ply", g2s::SynthShape::cube, 50'000);
   for (const bool compress : {false, true}) {
-    const std::string once = read_bytes(build(input, "a.tiles", 3000, compress));
-    const std::string again = read_bytes(build(input, "b.tiles", 3000, compress));
+    const std::string once = file_bytes(build(input, "a.tiles", 3000, compress));
+    const std::string again = file_bytes(build(input, "b.tiles", 3000, compress));
     // One tile per round: the input is re-read about 17 times, the bytes are the same.
-    const std::string rounds = read_bytes(build(input, "c.tiles", 3000, compress, 1));
+    const std::string rounds = file_bytes(build(input, "c.tiles", 3000, compress, 1));
     std::string one_thread;
     {
       const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
-      one_thread = read_bytes(build(input, "d.tiles", 3000, compress));
+      one_thread = file_bytes(build(input, "d.tiles", 3000, compress));
     }
     EXPECT_EQ(once, again);
     EXPECT_EQ(once, rounds);
@@ -410,7 +399,7 @@ class TileStoreDamage : public TileStoreTest {
   void SetUp() override {
     const fs::path input = synthetic("sphere.ply", g2s::SynthShape::sphere, 5000);
     store_ = build(input, "s.tiles", 1000, true);
-    bytes_ = read_bytes(store_);
+    bytes_ = file_bytes(store_);
   }
   fs::path damaged(const std::string& bytes) { return write("damaged.tiles", bytes); }
   std::string flipped(std::size_t offset) const {
@@ -517,44 +506,29 @@ TEST_F(TileStoreTest, RealScanBun000At1000PointsPerTile) {
   }
 }
 
-// Runs the CLI in the folder of out_path; output: its stdout and stderr.
-int run_cli(const std::string& args, const fs::path& out_path, std::string& output) {
-  const g2s::test_support::CliRun r = g2s::test_support::run_cli(args, out_path.parent_path());
-  output = r.out + r.err;
-  return r.code;
-}
-
 TEST_F(TileStoreTest, CliTileAndTileInfo) {
   const fs::path input = synthetic("sphere.ply", g2s::SynthShape::sphere, 5000);
-  const fs::path store = dir_ / "s.tiles";
-  const fs::path out = dir_ / "out.txt";
-  std::string output;
-  ASSERT_EQ(run_cli(fmt::format("tile \"{}\" \"{}\" --tile-points 800 --compress --json",
-                                input.string(), store.string()),
-                    out, output),
-            0)
-      << output;
+  const std::string store = (dir_ / "s.tiles").string();
+  auto run = [&](const std::vector<std::string>& args, int code) {
+    return g2s::test_support::cli_output(dir_, args, code);
+  };
+  std::string output =
+      run({"tile", input.string(), store, "--tile-points", "800", "--compress", "--json"}, 0);
   EXPECT_NE(output.find("\"points\":5005"), std::string::npos) << output;
   EXPECT_NE(output.find("\"compressed\":true"), std::string::npos) << output;
-  ASSERT_EQ(run_cli(fmt::format("tile-info \"{}\"", store.string()), out, output), 0) << output;
+  output = run({"tile-info", store}, 0);
   EXPECT_NE(output.find("points:     5005"), std::string::npos) << output;
-  ASSERT_EQ(run_cli(fmt::format("tile-info \"{}\" --json", store.string()), out, output), 0);
+  output = run({"tile-info", store, "--json"}, 0);
   EXPECT_NE(output.find("\"tiles\":[{\"points\":"), std::string::npos) << output;
 
   // A damaged block: tile-info reads every block, so it fails with exit 3 naming the tile.
-  std::string bytes = read_bytes(store);
+  std::string bytes = file_bytes(store);
   bytes[bytes.size() - 10] = static_cast<char>(bytes[bytes.size() - 10] ^ 1);
   const fs::path corrupt = write("corrupt.tiles", bytes);
-  EXPECT_EQ(run_cli(fmt::format("tile-info \"{}\"", corrupt.string()), out, output), 3);
+  output = run({"tile-info", corrupt.string()}, 3);
   EXPECT_NE(output.find("checksum mismatch"), std::string::npos) << output;
-  EXPECT_EQ(run_cli(fmt::format("tile \"{}\" \"{}\"", (dir_ / "none.ply").string(),
-                                (dir_ / "x.tiles").string()),
-                    out, output),
-            3);
-  EXPECT_EQ(run_cli(fmt::format("tile \"{}\" \"{}\" --tile-points 0", input.string(),
-                                (dir_ / "x.tiles").string()),
-                    out, output),
-            2);
+  run({"tile", (dir_ / "none.ply").string(), (dir_ / "x.tiles").string()}, 3);
+  run({"tile", input.string(), (dir_ / "x.tiles").string(), "--tile-points", "0"}, 2);
 }
 
 }  // namespace
