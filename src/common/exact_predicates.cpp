@@ -9,7 +9,10 @@
 // error-free transformations.
 #include "common/exact_predicates.hpp"
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 
 namespace g2s::exact {
 namespace {
@@ -145,13 +148,97 @@ Expansion<16> minor2(const Expansion<2>& p, const Expansion<2>& s, const Expansi
   return out;
 }
 
+// The integer fast path: when every coordinate difference is exact in double (as for float
+// input) and all of them are whole multiples of one power of two 2^e spanning at most `bits`
+// bits above it, they are scaled to integers and the determinant is taken in 128-bit integer
+// arithmetic, exactly, far faster than expansions. Exactly coplanar or collinear points (flat
+// scans quantised by their scanner) reach the exact stage on every call, so this is what they
+// cost.
+// x = mantissa * 2^exponent with an integer mantissa of at most 53 bits (x finite).
+struct Binary {
+  std::int64_t mantissa;
+  int exponent;
+};
+Binary binary(double x) {
+  const auto bits = std::bit_cast<std::uint64_t>(x);
+  const int biased = static_cast<int>(bits >> 52 & 0x7FF);
+  std::uint64_t mantissa = bits & ((std::uint64_t{1} << 52) - 1);
+  if (biased != 0) mantissa |= std::uint64_t{1} << 52;
+  const auto magnitude = static_cast<std::int64_t>(mantissa);
+  return {bits >> 63 ? -magnitude : magnitude, std::max(biased, 1) - 1075};
+}
+
+// Scales the n exact differences to integers in `out`; false when they span more than `bits`.
+bool to_integers(const double* d, int n, int bits, std::int64_t* out) {
+  Binary b[9];
+  int low = 1 << 20, high = -(1 << 20);
+  for (int k = 0; k < n; ++k) {
+    b[k] = binary(d[k]);
+    if (b[k].mantissa == 0) continue;
+    const auto magnitude = static_cast<std::uint64_t>(std::abs(b[k].mantissa));
+    low = std::min(low, b[k].exponent + std::countr_zero(magnitude));
+    high = std::max(high, b[k].exponent + 63 - std::countl_zero(magnitude));
+  }
+  if (high - low + 1 > bits) return false;
+  for (int k = 0; k < n; ++k) {
+    // exponent - low >= -(trailing zeros of the mantissa), so a right shift drops only zeros.
+    const int shift = b[k].exponent - low;
+    out[k] = shift >= 0 ? b[k].mantissa * (std::int64_t{1} << shift)
+                        : b[k].mantissa / (std::int64_t{1} << -shift);
+  }
+  return true;
+}
+
+// The differences b - a, when exact.
+bool exact_differences(const double* b, const double* a, int n, double* out) {
+  for (int k = 0; k < n; ++k) {
+    double tail;
+    two_diff(b[k], a[k], out[k], tail);
+    if (tail != 0.0) return false;
+  }
+  return true;
+}
+
+__extension__ typedef __int128 Int128;  // GCC and Clang on 64-bit targets
+
+int sign(Int128 x) {
+  return x > 0 ? 1 : (x < 0 ? -1 : 0);
+}
+
 int orient2d_exact(const double* a, const double* b, const double* c, int i, int j) {
+  {
+    const double pb[2] = {b[i], b[j]}, pc[2] = {c[i], c[j]}, pa[2] = {a[i], a[j]};
+    double d[4];
+    std::int64_t n[4];
+    // 2 * 62 bits + 1 fits 127.
+    if (exact_differences(pb, pa, 2, d) && exact_differences(pc, pa, 2, d + 2) &&
+        to_integers(d, 4, 62, n)) {
+      return sign(static_cast<Int128>(n[0]) * n[3] - static_cast<Int128>(n[1]) * n[2]);
+    }
+  }
   const Expansion<2> ui = difference(b[i], a[i]), uj = difference(b[j], a[j]);
   const Expansion<2> vi = difference(c[i], a[i]), vj = difference(c[j], a[j]);
   return minor2(ui, vj, uj, vi).sign();
 }
 
 int orient3d_exact(const double* a, const double* b, const double* c, const double* d) {
+  {
+    double diff[9];
+    std::int64_t n[9];
+    // Three factors of 41 bits and a sum of six terms: 123 + 3 bits fit 127.
+    if (exact_differences(b, a, 3, diff) && exact_differences(c, a, 3, diff + 3) &&
+        exact_differences(d, a, 3, diff + 6) && to_integers(diff, 9, 41, n)) {
+      const std::int64_t *u = n, *v = n + 3, *w = n + 6;
+      Int128 det = 0;
+      for (int k = 0; k < 3; ++k) {
+        const int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+        const Int128 minor =
+            static_cast<Int128>(u[k1]) * v[k2] - static_cast<Int128>(u[k2]) * v[k1];
+        det += minor * w[k];
+      }
+      return sign(det);
+    }
+  }
   Expansion<2> u[3], v[3], w[3];
   for (int k = 0; k < 3; ++k) {
     u[k] = difference(b[k], a[k]);

@@ -138,6 +138,10 @@ TEST(ExactPredicates, Orient2dMatchesIntegersOnRandomAndNearlyCollinearPoints) {
         << a[0] << " " << a[1] << " / " << b[0] << " " << b[1] << " / " << c[0] << " " << c[1];
     ASSERT_EQ(g2s::exact::orient2d(b, c, a, 0, 1), expected);
     ASSERT_EQ(g2s::exact::orient2d(b, a, c, 0, 1), -expected);
+    const double as[3] = {std::ldexp(a[0], 40), std::ldexp(a[1], 40), 0};
+    const double bs[3] = {std::ldexp(b[0], 40), std::ldexp(b[1], 40), 0};
+    const double cs[3] = {std::ldexp(c[0], 40), std::ldexp(c[1], 40), 0};
+    ASSERT_EQ(g2s::exact::orient2d(as, bs, cs, 0, 1), expected);
   }
   EXPECT_GT(exact_zero, 1000);  // the nearly collinear half really reaches zero
 }
@@ -181,6 +185,14 @@ TEST(ExactPredicates, Orient3dMatchesIntegersOnRandomAndNearlyCoplanarPoints) {
     ASSERT_EQ(g2s::exact::orient3d(b, c, a, d), expected) << trial;
     ASSERT_EQ(g2s::exact::orient3d(b, a, c, d), -expected) << trial;
     ASSERT_EQ(g2s::exact::orient3d(d, b, c, a), -expected) << trial;
+    // Scaled by a power of two (exactly): the same sign, whichever of the integer fast path or
+    // the expansions decides it.
+    double as[3], bs[3], cs[3], ds[3];
+    for (int k = 0; k < 3; ++k) {
+      as[k] = std::ldexp(a[k], -70), bs[k] = std::ldexp(b[k], -70);
+      cs[k] = std::ldexp(c[k], -70), ds[k] = std::ldexp(d[k], -70);
+    }
+    ASSERT_EQ(g2s::exact::orient3d(as, bs, cs, ds), expected) << trial;
   }
   EXPECT_GT(exact_zero, 300);
 }
