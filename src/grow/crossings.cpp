@@ -29,17 +29,24 @@ bool triangles_cross(std::span<const Vec3f> points, const Triangle& a, const Tri
   return g2s::triangles_cross(ta, tb);
 }
 
+bool padded_circumball(const Vec3& a, const Vec3& b, const Vec3& c, Ball& out) {
+  if (!circumball(a, b, c, out)) return false;
+  const double radius2 = std::max({out.radius2, norm2(b - out.centre), norm2(c - out.centre)});
+  const double size = std::abs(out.centre.x) + std::abs(out.centre.y) + std::abs(out.centre.z);
+  const double reach = std::sqrt(radius2) * (1 + 1e-8) + 1e-8 * size;
+  out.radius2 = reach * reach;
+  return true;
+}
+
 bool in_empty_ball(const HashGrid& grid, const Triangle& t) {
-  const Vec3 a = grid.position(t[0]), b = grid.position(t[1]), c = grid.position(t[2]);
   Ball ball;
-  if (!circumball(a, b, c, ball)) return false;
-  const double radius2 = std::max({ball.radius2, norm2(b - ball.centre), norm2(c - ball.centre)});
-  const double size = std::abs(ball.centre.x) + std::abs(ball.centre.y) + std::abs(ball.centre.z);
+  if (!padded_circumball(grid.position(t[0]), grid.position(t[1]), grid.position(t[2]), ball)) {
+    return false;
+  }
   bool empty = true;
-  grid.for_each_in_ball(ball.centre, std::sqrt(radius2) * (1 + 1e-8) + 1e-8 * size,
-                        [&](std::uint32_t j, double) {
-                          if (j != t[0] && j != t[1] && j != t[2]) empty = false;
-                        });
+  grid.for_each_in_ball(ball.centre, std::sqrt(ball.radius2), [&](std::uint32_t j, double) {
+    if (j != t[0] && j != t[1] && j != t[2]) empty = false;
+  });
   return empty;
 }
 
@@ -56,58 +63,76 @@ Pairs sorted_union(tbb::enumerable_thread_specific<Pairs>& found) {
 }  // namespace
 
 Pairs TriangleCells::crossing_pairs() const {
+  const Level& first = levels_[0];
   tbb::enumerable_thread_specific<Pairs> found;
-  // Small triangles: each cell against itself and its 13 neighbours on the forward side, so
-  // that every pair of cells is met once. Boxes are read in filing order (small_.boxes), so the
+  // The first level: each cell against itself and its 13 neighbours on the forward side, so
+  // that every pair of cells is met once. Boxes are read in filing order (first.boxes), so the
   // pairs of two cells are tested from two short runs of memory.
   const auto cell_pairs = [&](std::size_t slot, Pairs& pairs) {
     const auto test = [&](std::uint32_t i, std::uint32_t j) {
-      if (!overlap(small_.boxes[i], small_.boxes[j])) return;
-      const std::uint32_t s = small_.filed[i], t = small_.filed[j];
+      if (!overlap(first.boxes[i], first.boxes[j])) return;
+      const std::uint32_t s = first.filed[i], t = first.filed[j];
       if (degenerate_[s] || degenerate_[t]) return;
       if (triangles_cross(points_, triangles_[s], triangles_[t])) {
         pairs.push_back({std::min(s, t), std::max(s, t)});
       }
     };
-    const std::uint64_t k = small_.keys[slot];
-    for (std::uint32_t i = small_.begin[slot]; i < small_.end[slot]; ++i) {
-      for (std::uint32_t j = i + 1; j < small_.end[slot]; ++j) test(i, j);
+    const std::uint64_t k = first.keys[slot];
+    for (std::uint32_t i = first.begin[slot]; i < first.end[slot]; ++i) {
+      for (std::uint32_t j = i + 1; j < first.end[slot]; ++j) test(i, j);
     }
     const auto x = static_cast<std::int64_t>(k >> 42) - kBias;
     const auto y = static_cast<std::int64_t>(k >> 21 & 0x1FFFFF) - kBias;
     const auto z = static_cast<std::int64_t>(k & 0x1FFFFF) - kBias;
     for (int d = 14; d < 27; ++d) {  // offsets (dx, dy, dz) after (0, 0, 0) in z-y-x order
-      const std::size_t other = small_.find(key(x + d % 3 - 1, y + d / 3 % 3 - 1, z + d / 9 - 1));
-      if (other == small_.keys.size()) continue;
-      for (std::uint32_t i = small_.begin[slot]; i < small_.end[slot]; ++i) {
-        for (std::uint32_t j = small_.begin[other]; j < small_.end[other]; ++j) test(i, j);
+      const std::size_t other = first.find(key(x + d % 3 - 1, y + d / 3 % 3 - 1, z + d / 9 - 1));
+      if (other == first.keys.size()) continue;
+      for (std::uint32_t i = first.begin[slot]; i < first.end[slot]; ++i) {
+        for (std::uint32_t j = first.begin[other]; j < first.end[other]; ++j) test(i, j);
       }
     }
   };
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, small_.keys.size(), 4096),
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, first.keys.size(), 4096),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       Pairs& pairs = found.local();
                       for (std::size_t slot = range.begin(); slot < range.end(); ++slot) {
-                        if (small_.keys[slot] != kEmpty) cell_pairs(slot, pairs);
+                        if (first.keys[slot] != kEmpty) cell_pairs(slot, pairs);
                       }
                     });
-  // Larger triangles against everything near them (each pair of two larger ones once).
+  // Triangles of the larger levels against everything near them (each pair of two such once).
   Pairs& pairs = found.local();
   const auto against_all = [&](std::uint32_t t) {
     for_each_near(boxes_[t].lo, boxes_[t].hi, [&](std::uint32_t other) {
-      if (other == t || (size_[other] != 0 && other < t)) return;
+      if (other == t || (level_[other] != 0 && other < t)) return;
       if (degenerate_[t] || degenerate_[other]) return;
       if (triangles_cross(points_, triangles_[t], triangles_[other])) {
         pairs.push_back({std::min(t, other), std::max(t, other)});
       }
     });
   };
-  for (const std::uint32_t t : large_.filed) against_all(t);
-  for (const std::uint32_t t : huge_) against_all(t);
+  for (std::size_t l = 1; l < levels_.size(); ++l) {
+    for (const std::uint32_t t : levels_[l].filed) against_all(t);
+  }
   return sorted_union(found);
 }
 
+bool TriangleCells::apart(const Triangle& t, const Ball& ball, std::uint32_t other) const {
+  const Ball& other_ball = balls_[other];
+  if (ball.radius2 < 0 || other_ball.radius2 < 0) return false;
+  const Triangle& o = triangles_[other];
+  const auto outside = [&](const Triangle& own, const Triangle& rest, const Ball& around) {
+    for (const Index v : own) {
+      if (std::find(rest.begin(), rest.end(), v) != rest.end()) continue;
+      if (!(norm2(Vec3(points_[v]) - around.centre) > around.radius2)) return false;
+    }
+    return true;
+  };
+  return outside(t, o, other_ball) && outside(o, t, ball);
+}
+
 Pairs TriangleCells::crossing_pairs_involving(std::span<const std::uint32_t> focus) const {
+  std::vector<std::uint8_t> focused(triangles_.size(), 0);
+  for (const std::uint32_t t : focus) focused[t] = 1;
   tbb::enumerable_thread_specific<Pairs> found;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, focus.size(), 256),
                     [&](const tbb::blocked_range<std::size_t>& range) {
@@ -116,7 +141,11 @@ Pairs TriangleCells::crossing_pairs_involving(std::span<const std::uint32_t> foc
                         const std::uint32_t t = focus[f];
                         if (degenerate_[t]) continue;
                         for_each_near(boxes_[t].lo, boxes_[t].hi, [&](std::uint32_t other) {
-                          if (other == t || degenerate_[other]) return;
+                          // A pair of two focused triangles is tested from the smaller.
+                          if (other == t || degenerate_[other] || (focused[other] && other < t)) {
+                            return;
+                          }
+                          if (apart(t, other)) return;
                           if (triangles_cross(points_, triangles_[t], triangles_[other])) {
                             pairs.push_back({std::min(t, other), std::max(t, other)});
                           }
@@ -180,8 +209,9 @@ TriangleCells::TriangleCells(std::span<const Vec3f> points, std::span<const Tria
     : points_(points),
       triangles_(triangles),
       boxes_(triangles.size()),
-      size_(triangles.size(), 0),
-      degenerate_(triangles.size(), 0) {
+      level_(triangles.size(), 0),
+      degenerate_(triangles.size(), 0),
+      balls_(triangles.size()) {
   std::vector<float> extents(triangles.size());
   for (std::uint32_t t = 0; t < triangles.size(); ++t) {
     const Triangle& tri = triangles[t];
@@ -193,34 +223,33 @@ TriangleCells::TriangleCells(std::span<const Vec3f> points, std::span<const Tria
               std::max({p0.z, p1.z, p2.z})};
     extents[t] = std::max({box.hi.x - box.lo.x, box.hi.y - box.lo.y, box.hi.z - box.lo.z});
     degenerate_[t] = detail::degenerate(points, tri);
+    if (!padded_circumball(Vec3(p0), Vec3(p1), Vec3(p2), balls_[t])) balls_[t].radius2 = -1;
   }
-  // The small cell holds nine triangles in ten whole: the rest are few enough to be looked up
-  // from their own, larger cells.
+  // The first level's cell holds nine triangles in ten whole; the rest are few enough to be
+  // looked up from their own, larger cells.
   double cell = 1;
+  float largest = 0;
   if (!triangles.empty()) {
     std::vector<float> sorted = extents;
     const auto at = sorted.begin() + static_cast<long>(sorted.size() * 9 / 10);
     std::nth_element(sorted.begin(), at, sorted.end());
     cell = std::max(1.05 * *at, 1e-30);
+    largest = *std::max_element(extents.begin(), extents.end());
   }
-  constexpr double kLargeCells = 8;  // the large cell's edge, in small cells
-  small_.inverse_cell = 1.0 / cell;
-  large_.inverse_cell = 1.0 / (kLargeCells * cell);
-  std::vector<std::uint32_t> small, large;
-  small.reserve(triangles.size());
+  constexpr double kGrowth = 8;  // a level's cell edge, in the previous level's
+  levels_.emplace_back().inverse_cell = 1.0 / cell;
+  for (double edge = cell; largest > 0.99 * edge; edge *= kGrowth) {
+    levels_.emplace_back().inverse_cell = 1.0 / (kGrowth * edge);
+  }
+  std::vector<std::vector<std::uint32_t>> members(levels_.size());
+  members[0].reserve(triangles.size());
   for (std::uint32_t t = 0; t < triangles.size(); ++t) {
-    if (extents[t] <= 0.99 * cell) {
-      small.push_back(t);
-    } else if (extents[t] <= 0.99 * kLargeCells * cell) {
-      large.push_back(t);
-      size_[t] = 1;
-    } else {
-      huge_.push_back(t);
-      size_[t] = 2;
-    }
+    std::size_t l = 0;
+    while (l + 1 < levels_.size() && extents[t] > 0.99 / levels_[l].inverse_cell) ++l;
+    level_[t] = static_cast<std::uint8_t>(l);
+    members[l].push_back(t);
   }
-  build(small_, small);
-  build(large_, large);
+  for (std::size_t l = 0; l < levels_.size(); ++l) build(levels_[l], members[l]);
 }
 
 }  // namespace g2s::detail

@@ -28,15 +28,21 @@ bool degenerate(std::span<const Vec3f> points, const Triangle& t);
 // this certificate need to be searched for crossings, and on a clean scan they are few.
 bool in_empty_ball(const HashGrid& grid, const Triangle& t);
 
+// The ball through a, b and c centred in their plane, its radius padded by 1e-8 of itself and of
+// the centre's coordinates (far beyond the rounding of the centre): a point outside it is
+// outside the exact ball. False for (nearly) collinear corners.
+bool padded_circumball(const Vec3& a, const Vec3& b, const Vec3& c, Ball& out);
+
 // True when the closed triangles a and b (corner indices into points, which hold no two equal
 // positions; neither degenerate) intersect other than in corners or an edge they share; exact
 // (common/triangle_intersection.hpp). The same triangle twice never crosses.
 bool triangles_cross(std::span<const Vec3f> points, const Triangle& a, const Triangle& b);
 
-// Triangles filed by the cell of their bounding box's lower corner, in two sizes of cell: a
-// triangle whose box fits in the small cell (nearly all) is filed there, a larger one in the
-// large cell, a larger one still in a list. Two triangles whose boxes overlap are then filed in
-// the same or neighbouring cells, so a query reads a few cells, and a build is one counting pass.
+// Triangles filed by the cell of their bounding box's lower corner, in levels of cells each 8
+// times larger than the one before: a triangle is filed in the first level whose cell its box
+// fits (the first level holds nine in ten). Two triangles whose boxes overlap are then filed in the
+// same or neighbouring cells of their levels, so a query reads a few cells per level, and a
+// build is one counting pass per level.
 // Inputs: points (the triangles' corners index them), triangles. The spans must outlive the
 // object.
 class TriangleCells {
@@ -49,11 +55,18 @@ class TriangleCells {
 
   bool degenerate(std::uint32_t t) const { return degenerate_[t] != 0; }
 
+  // Whether triangle t (not filed here), with its padded circumball (padded_circumball), and
+  // the filed triangle `other` each have their corners the other lacks outside the other's
+  // ball: then they cannot cross (the argument of in_empty_ball).
+  bool apart(const Triangle& t, const Ball& ball, std::uint32_t other) const;
+
   // Every pair (s, t), s < t, of non-degenerate triangles that cross (triangles_cross). Sorted.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_pairs() const;
 
   // The pairs (s, t), s < t, of non-degenerate triangles that cross where s or t is in `focus`
-  // (ascending triangle indices). Sorted, each pair once.
+  // (ascending triangle indices). Sorted, each pair once. A pair whose corners each lie outside
+  // the other's circumball (apart) cannot cross, by the argument of in_empty_ball, and is not
+  // tested further.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_pairs_involving(
       std::span<const std::uint32_t> focus) const;
 
@@ -80,6 +93,7 @@ class TriangleCells {
            a.lo.z <= b.hi.z && b.lo.z <= a.hi.z;
   }
   void build(Level& level, std::span<const std::uint32_t> members);
+  bool apart(std::uint32_t s, std::uint32_t t) const { return apart(triangles_[s], balls_[s], t); }
   // Calls visit(t) for the triangles of `level` whose lower corner lies in the cells that
   // [lo - cell, hi] covers: every filed triangle whose box can overlap [lo, hi].
   template <class Visit>
@@ -88,10 +102,10 @@ class TriangleCells {
   std::span<const Vec3f> points_;
   std::span<const Triangle> triangles_;
   std::vector<Box> boxes_;
-  std::vector<std::uint8_t> size_;  // per triangle: 0 small, 1 large, 2 huge
+  std::vector<std::uint8_t> level_;  // per triangle: the level it is filed in
   std::vector<std::uint8_t> degenerate_;
-  Level small_, large_;
-  std::vector<std::uint32_t> huge_;
+  std::vector<Ball> balls_;  // padded circumballs; radius2 < 0: none (nearly collinear)
+  std::vector<Level> levels_;
 };
 
 template <class Visit>
@@ -118,9 +132,9 @@ void TriangleCells::for_each_near(const Vec3f& lo, const Vec3f& hi, Visit&& visi
   const auto near = [&](std::uint32_t t) {
     if (overlap(boxes_[t], query)) visit(t);
   };
-  scan(small_, lo, hi, near);
-  scan(large_, lo, hi, near);
-  for (const std::uint32_t t : huge_) near(t);
+  for (const Level& level : levels_) {
+    if (!level.filed.empty()) scan(level, lo, hi, near);
+  }
 }
 
 }  // namespace g2s::detail

@@ -621,11 +621,16 @@ class Grower {
       });
       if (covers_context) return false;
     }
+    Ball padded;
+    const bool has_ball = detail::padded_circumball(grid_.position(t[0]), grid_.position(t[1]),
+                                                    grid_.position(t[2]), padded);
     bool crosses = false;
     cells.for_each_near(lo, hi, [&](std::uint32_t other) {
+      if (crosses) return;
       const Triangle& o = triangles_[other];
-      crosses = crosses || std::is_permutation(o.begin(), o.end(), t.begin()) ||
-                (!cells.degenerate(other) && detail::triangles_cross(grid_.points(), t, o));
+      crosses = std::is_permutation(o.begin(), o.end(), t.begin()) ||
+                (!cells.degenerate(other) && !(has_ball && cells.apart(t, padded, other)) &&
+                 detail::triangles_cross(grid_.points(), t, o));
     });
     return !crosses;
   }

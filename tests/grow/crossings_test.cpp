@@ -23,7 +23,10 @@ Soup random_soup(std::size_t count, int large_every, unsigned seed) {
   std::uniform_real_distribution<float> where(0, 10), offset(-0.6f, 0.6f);
   Soup soup;
   for (std::size_t t = 0; t < count; ++t) {
-    const float scale = (large_every > 0 && t % static_cast<std::size_t>(large_every) == 0) ? 8 : 1;
+    // Most large ones 8 times, one in five of them 60 times: three levels of cells at least.
+    const auto every = static_cast<std::size_t>(large_every);
+    const float scale =
+        large_every > 0 && t % every == 0 ? (t % (5 * every) == 0 ? 60.0f : 8.0f) : 1.0f;
     const Vec3f c{where(rng), where(rng), where(rng) * 0.1f};
     const auto first = static_cast<Index>(soup.points.size());
     for (int k = 0; k < 3; ++k) {
