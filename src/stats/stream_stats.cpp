@@ -234,6 +234,7 @@ struct StreamStats::Impl {
   MeshStats stats = crossings_not_counted();
   bool complete = true;
   std::uint32_t numbered = 0;  // vertices given so far
+  std::uint64_t peak = 0;      // bytes() before the forests last shrank
 
   // The open vertices' records, in chunks that never move (growing copies nothing and holds no
   // spare half), and their union-find nodes apart, so that rebuilding the forests reads only
@@ -374,8 +375,10 @@ struct StreamStats::Impl {
     open_of.insert(number, o);
   }
 
-  // Rebuilds both forests over the roots the open vertices reach.
+  // Rebuilds both forests over the roots the open vertices reach (after noting the peak: the
+  // forests shrink here, the rest never does).
   void compact() {
+    peak = std::max(peak, bytes());
     std::vector<std::uint32_t*> component_nodes, border_nodes;
     for (Nodes& v : node) {
       if (v.refs == 0) continue;  // a free slot
@@ -698,7 +701,7 @@ bool StreamStats::complete() const {
   return impl_->complete;
 }
 std::uint64_t StreamStats::peak_bytes() const {
-  return impl_->bytes();
+  return std::max(impl_->peak, impl_->bytes());
 }
 
 }  // namespace g2s
