@@ -159,16 +159,16 @@ TEST(StreamStats, RandomSoupsWithWeldedPositions) {
   }
 }
 
-// A closed grid surface (a torus) of 60,000 vertices, big enough for every path of the counter:
+// A closed grid surface (a torus) of 144,000 vertices, big enough for every path of the counter:
 // the weld cells sized from the first 1,024 triangles, more than one chunk of vertex records,
-// vertex numbers that stay open while more than the number window (32,768) passes (the first
+// vertex numbers that stay open while more than the number window (131,072) passes (the first
 // row waits for the last), stars judged by the one-pass test and, where defects are, by the
 // general one. Defects: holes, a triangle reversed, a fin, duplicates, orientation groups in
 // stripes with some flipped, coordinates snapped so that exact zeros of both signs occur, and
 // twins of vertices at their positions (welded). With float positions (STL), twins 1e-12 away
 // weld too.
 TEST(StreamStats, LargeSurfaceWithDefectsAsComputeStatsCountsIt) {
-  const std::uint32_t rows = 200, columns = 300;
+  const std::uint32_t rows = 400, columns = 360;
   IndexedMesh mesh;
   for (std::uint32_t r = 0; r < rows; ++r) {
     for (std::uint32_t c = 0; c < columns; ++c) {
@@ -183,7 +183,7 @@ TEST(StreamStats, LargeSurfaceWithDefectsAsComputeStatsCountsIt) {
   std::mt19937 random(11);
   for (std::uint32_t r = 0; r < rows; ++r) {
     for (std::uint32_t c = 0; c < columns; ++c) {
-      const std::uint32_t stripe = r / 25;
+      const std::uint32_t stripe = r / 50;
       const Triangle a{at(r, c), at(r, c + 1), at(r + 1, c + 1)};
       const Triangle b{at(r, c), at(r + 1, c + 1), at(r + 1, c)};
       for (Triangle t : {a, b}) {
@@ -207,7 +207,7 @@ TEST(StreamStats, LargeSurfaceWithDefectsAsComputeStatsCountsIt) {
       }
     }
   }
-  std::vector<std::uint8_t> flip(rows / 25 + 2);
+  std::vector<std::uint8_t> flip(rows / 50 + 2);
   for (std::size_t g = 0; g < flip.size(); ++g) flip[g] = g % 3 == 1;
   for (bool float_positions : {false, true}) {
     IndexedMesh stored = as_written(mesh, group, flip);
