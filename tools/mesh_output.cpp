@@ -225,7 +225,11 @@ void write_and_report(const TileSource& source,
   const StageTime measured{seconds_since(summary_start), cpu_seconds() - summary_cpu};
   const double seconds = seconds_since(facts.start);
   const double ktps = static_cast<double>(triangles) / seconds / 1000.0;
+  // Taken after the summary, so that it holds the counter (all along the run) and any
+  // read-back; the counter's own share is reported apart.
   const double peak_mb = peak_rss_mb();
+  const double counter_mb =
+      args.no_stats ? 0.0 : static_cast<double>(counter.peak_bytes()) / (1024.0 * 1024.0);
   if (args.json) {
     JsonObject json;
     json.text("input", facts.input)
@@ -266,6 +270,7 @@ void write_and_report(const TileSource& source,
                                 .fixed("wall", measured.wall, 3)
                                 .fixed("cpu", measured.cpu, 3)
                                 .number("in_stride", measure && stream_exact)
+                                .fixed("counter_peak_mb", counter_mb, 1)
                                 .str())
             .str());
     if (measure) json.raw("stats", stats_to_json(stats));

@@ -22,7 +22,8 @@ namespace g2s {
 // Outputs (stats(), after finish()): every count of MeshStats except coverage (has_coverage is
 // false) and the crossing pairs, which need the whole mesh. complete() is false when a triangle
 // came for a vertex already announced done (the counts are then not those of the file).
-// peak_bytes(): the most memory the counter held (its live vertices and triangles).
+// peak_bytes(): the most memory the counter held at any time (its open vertices and their
+// stars, its tables), in bytes.
 class StreamStats final : public MeshSink {
  public:
   StreamStats(MeshSink& next, bool float_positions);

@@ -13,11 +13,20 @@
 // and it is rebuilt over the open vertices' roots whenever it has grown to twice their number.
 // Orientation conflicts between two groups depend on the flips decided at the end: those edges
 // are tallied per pair of groups and settled in finish().
+//
+// Cost: the counter runs on the stitcher's thread, once per vertex and triangle, so its lookups
+// are laid out for the stream's locality (bench/results/2026-11-24-summary-cost.md): vertex
+// numbers map to records through a window of recent numbers, positions weld through a hash
+// whose slots follow space, records never move, and most stars (no two triangles sharing the
+// corner after, or the one before) are judged in one pass without grouping their edges.
 #include "g2s/stream_stats.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
+#include <cmath>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "common/id_map.hpp"
@@ -79,6 +88,116 @@ std::uint64_t mix(std::uint64_t x) {
   return x ^ (x >> 33);
 }
 
+// Open-addressing table of 64-bit slots (key in the high half, value in the low half; all ones:
+// empty), linear probing and backward-shift deletion. The home slot is a function of the key
+// alone, given by the user, so probing and deleting never read anything outside the table.
+class SlotTable {
+ public:
+  static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
+  static std::uint64_t slot(std::uint32_t key, std::uint32_t value) {
+    return std::uint64_t{key} << 32 | value;
+  }
+  static std::uint32_t key_of(std::uint64_t s) { return static_cast<std::uint32_t>(s >> 32); }
+  static std::uint32_t value_of(std::uint64_t s) { return static_cast<std::uint32_t>(s); }
+
+  std::size_t size() const { return size_; }
+  std::size_t capacity() const { return slots_.capacity(); }
+  std::size_t mask() const { return mask_; }
+  const std::vector<std::uint64_t>& slots() const { return slots_; }
+
+  // Calls visit(slot) for the slots from home(key) until an empty one or visit returns true;
+  // returns the slot visit accepted, or kEmpty.
+  std::uint64_t probe(std::size_t home, const auto& accept) const {
+    if (slots_.empty()) return kEmpty;
+    for (std::size_t k = home & mask_;; k = (k + 1) & mask_) {
+      if (slots_[k] == kEmpty || accept(slots_[k])) return slots_[k];
+    }
+  }
+  // Adds a slot whose key is not there yet; `home` maps a key to its home slot (before masking).
+  void insert(std::uint64_t s, const auto& home) {
+    if (2 * (size_ + 1) > slots_.size()) {
+      std::vector<std::uint64_t> old = std::exchange(slots_, {});
+      slots_.assign(std::max<std::size_t>(64, 2 * old.size()), kEmpty);
+      mask_ = slots_.size() - 1;
+      for (std::uint64_t e : old) {
+        if (e != kEmpty) place(e, home);
+      }
+    }
+    place(s, home);
+    ++size_;
+  }
+  // Removes slot `s` (there).
+  void erase(std::uint64_t s, const auto& home) {
+    std::size_t hole = home(key_of(s)) & mask_;
+    while (slots_[hole] != s) hole = (hole + 1) & mask_;
+    for (std::size_t k = (hole + 1) & mask_; slots_[k] != kEmpty; k = (k + 1) & mask_) {
+      const std::size_t want = home(key_of(slots_[k])) & mask_;
+      if (((k - want) & mask_) >= ((k - hole) & mask_)) {
+        slots_[hole] = slots_[k];
+        hole = k;
+      }
+    }
+    slots_[hole] = kEmpty;
+    --size_;
+  }
+
+ private:
+  void place(std::uint64_t s, const auto& home) {
+    std::size_t k = home(key_of(s)) & mask_;
+    while (slots_[k] != kEmpty) k = (k + 1) & mask_;
+    slots_[k] = s;
+  }
+  std::vector<std::uint64_t> slots_;
+  std::size_t mask_ = 0;
+  std::size_t size_ = 0;
+};
+
+// Vertex number -> open vertex, for numbers inserted in increasing order. The last kWindow
+// numbers sit directly at number % kWindow: triangles use recent vertices, so almost every lookup
+// is one read of a table that stays in cache. A number still open when the window passes it (a
+// vertex on a seam waiting for the next tile) moves to a hash table.
+class NumberMap {
+ public:
+  static constexpr std::uint32_t kMissing = 0xFFFFFFFFu;
+  std::uint32_t find(std::uint32_t number) const {
+    if (recent_.empty()) return kMissing;
+    const std::uint64_t e = recent_[number & kWindowMask];
+    if (e != SlotTable::kEmpty && SlotTable::key_of(e) == number) return SlotTable::value_of(e);
+    const std::uint64_t s = older_.probe(
+        home(number), [number](std::uint64_t o) { return SlotTable::key_of(o) == number; });
+    return s == SlotTable::kEmpty ? kMissing : SlotTable::value_of(s);
+  }
+  void insert(std::uint32_t number, std::uint32_t value) {
+    if (recent_.empty()) recent_.assign(kWindow, SlotTable::kEmpty);
+    std::uint64_t& e = recent_[number & kWindowMask];
+    if (e != SlotTable::kEmpty) older_.insert(e, home);
+    e = SlotTable::slot(number, value);
+  }
+  void erase(std::uint32_t number) {
+    if (recent_.empty()) return;
+    std::uint64_t& e = recent_[number & kWindowMask];
+    if (e != SlotTable::kEmpty && SlotTable::key_of(e) == number) {
+      e = SlotTable::kEmpty;
+      return;
+    }
+    const std::uint64_t s = older_.probe(
+        home(number), [number](std::uint64_t o) { return SlotTable::key_of(o) == number; });
+    if (s != SlotTable::kEmpty) older_.erase(s, home);
+  }
+  std::uint64_t bytes() const {
+    return (recent_.capacity() + older_.capacity()) * sizeof(std::uint64_t);
+  }
+
+ private:
+  static constexpr std::uint32_t kWindow = 1u << 17;
+  static constexpr std::uint32_t kWindowMask = kWindow - 1;
+  static std::size_t home(std::uint32_t number) {
+    return static_cast<std::size_t>((std::uint64_t{number} * 0x9E3779B97F4A7C15ull) >> 20);
+  }
+  std::vector<std::uint64_t> recent_;
+  SlotTable older_;
+};
+
 // One edge {v, w} seen from v while judging v's star.
 struct EdgeGroup {
   std::uint32_t w;      // the other end, as a vertex number
@@ -91,8 +210,6 @@ struct EdgeGroup {
 }  // namespace
 
 struct StreamStats::Impl {
-  // An open vertex: welded by position; `rep` is the number of its first vertex, the name its
-  // triangles use.
   // A triangle as seen from one of its corners: the corners after and before it, and its group.
   struct Wedge {
     std::uint32_t next;
@@ -100,12 +217,12 @@ struct StreamStats::Impl {
     std::uint32_t group;
   };
   static constexpr std::uint32_t kInlineWedges = 9;  // most stars fit (G2S: about 6)
-  struct Open {
-    double xyz[3];
+  // An open vertex: welded by position; `rep` is the number of its first vertex, the name its
+  // triangles use. Two cache lines (the header and the first four wedges in the first): its
+  // position is kept apart (`position`), since only a weld key match reads it.
+  struct alignas(64) Open {
     std::uint32_t rep;
-    std::uint32_t refs;  // vertex numbers welded here and not yet done
-    std::uint32_t component;
-    std::uint32_t border;    // node in the boundary-edge graph
+    std::uint32_t key;       // its weld key
     std::uint32_t wedges;    // its star's triangles so far
     std::uint32_t overflow;  // the list holding wedges past the inline ones (kNoIndex: none)
     Wedge inline_wedges[kInlineWedges];
@@ -117,13 +234,33 @@ struct StreamStats::Impl {
   MeshStats stats = crossings_not_counted();
   bool complete = true;
   std::uint32_t numbered = 0;  // vertices given so far
+  std::uint64_t peak = 0;      // bytes() before the forests last shrank
 
-  std::vector<Open> open;
+  // The open vertices' records, in chunks that never move (growing copies nothing and holds no
+  // spare half), and their union-find nodes apart, so that rebuilding the forests reads only
+  // those.
+  static constexpr std::uint32_t kChunkBits = 10;
+  std::vector<std::unique_ptr<Open[]>> chunks;
+  std::uint32_t slots = 0;  // records made so far
+  struct Nodes {
+    std::uint32_t refs;  // vertex numbers welded here and not yet done (0: a free slot)
+    std::uint32_t component;
+    std::uint32_t border;  // node in the boundary-edge graph
+  };
+  std::vector<Nodes> node;
+  std::vector<std::array<double, 3>> position;  // as the file stores it
+  Open& open(std::uint32_t o) { return chunks[o >> kChunkBits][o & ((1u << kChunkBits) - 1)]; }
+  const Open& open(std::uint32_t o) const {
+    return chunks[o >> kChunkBits][o & ((1u << kChunkBits) - 1)];
+  }
   std::vector<std::uint32_t> free_open;
   std::size_t open_count = 0;
-  IdMap open_of;                      // vertex number -> open vertex
-  std::vector<std::uint32_t> welder;  // position hash table of open vertices (kNoIndex: empty)
-  std::size_t welder_mask = 0;
+  NumberMap open_of;               // vertex number -> open vertex
+  SlotTable welder;                // weld key -> open vertex, over the open vertices
+  double inverse_cell_size = 0.0;  // the welder's cells (0: not sized yet)
+  double edge_sum = 0.0;           // the first triangles' edges, to size the cells
+  std::uint32_t edges_summed = 0;
+  static constexpr std::uint32_t kEdgesForCells = 1024;
   std::vector<std::vector<Wedge>> overflow;  // large stars' further wedges
   std::vector<std::uint32_t> free_overflow;
   OpenUnionFind components;
@@ -143,87 +280,107 @@ struct StreamStats::Impl {
   std::vector<std::uint32_t> group_next, group_prev, fan;
   std::vector<std::uint8_t> fan_open;
 
-  std::size_t home(const double* p) const {
-    return mix(key_bits(p[0]) * 0x9e3779b97f4a7c15ULL ^
-               mix(key_bits(p[1]) + 0x632be59bd9b4e019ULL) ^ key_bits(p[2])) &
-           welder_mask;
-  }
   bool same_position(const double* a, const double* b) const {
     return key_bits(a[0]) == key_bits(b[0]) && key_bits(a[1]) == key_bits(b[1]) &&
            key_bits(a[2]) == key_bits(b[2]);
   }
-  void welder_insert(std::uint32_t o) {
-    if (2 * (open_count + 1) > welder.size()) {
-      std::vector<std::uint32_t> old = std::exchange(welder, {});
-      welder.assign(std::max<std::size_t>(64, 2 * old.size()), kNoIndex);
-      welder_mask = welder.size() - 1;
-      for (std::uint32_t e : old) {
-        if (e != kNoIndex) welder_place(e);
+  // The welder's key of a position: 24 bits naming its cell (a cube of side cell_size, or the
+  // position itself before the size is known) over 8 bits of the exact position. Vertices near
+  // each other in space, which the stream gives near each other in time, share their cell's run
+  // of slots, so most probes hit a cache line a neighbour just used.
+  std::uint32_t weld_key(const double* p) const {
+    double c[3];
+    for (int k = 0; k < 3; ++k) {
+      const double d = p[k] == 0.0 ? 0.0 : p[k];
+      c[k] = inverse_cell_size > 0.0 ? std::floor(d * inverse_cell_size) : d;
+    }
+    const std::uint64_t cell = mix(key_bits(c[0]) * 0x9e3779b97f4a7c15ULL ^
+                                   mix(key_bits(c[1]) + 0x632be59bd9b4e019ULL) ^ key_bits(c[2]));
+    const std::uint64_t exact =
+        mix(key_bits(p[0]) ^ std::rotl(key_bits(p[1]), 21) ^ std::rotl(key_bits(p[2]), 42));
+    return static_cast<std::uint32_t>(cell >> 40) << 8 | static_cast<std::uint32_t>(exact >> 56);
+  }
+  static std::size_t weld_home(std::uint32_t key) {
+    return static_cast<std::size_t>((std::uint64_t{key >> 8} * 0x9E3779B97F4A7C15ull) >> 24 << 3 |
+                                    (key & 7));
+  }
+  std::uint32_t welder_find(const double* p, std::uint32_t key) const {
+    const std::uint64_t s = welder.probe(weld_home(key), [&](std::uint64_t e) {
+      return SlotTable::key_of(e) == key &&
+             same_position(position[SlotTable::value_of(e)].data(), p);
+    });
+    return s == SlotTable::kEmpty ? kNoIndex : SlotTable::value_of(s);
+  }
+  void welder_insert(std::uint32_t o, std::uint32_t key) {
+    open(o).key = key;
+    welder.insert(SlotTable::slot(key, o), weld_home);
+  }
+  void welder_erase(std::uint32_t o) { welder.erase(SlotTable::slot(open(o).key, o), weld_home); }
+  // Sets the welder's cell size from the first triangles' edges (the power of two at or above
+  // their mean |dx| + |dy| + |dz|: a few vertices a cell) and rebuilds it; the counts do not
+  // depend on it, only the welder's speed.
+  void size_cells() {
+    const double edge = edge_sum / static_cast<double>(edges_summed);
+    if (!(edge > 0.0) || !std::isfinite(edge)) return;
+    inverse_cell_size = 1.0 / std::exp2(std::ceil(std::log2(edge)));
+    if (!std::isfinite(inverse_cell_size)) inverse_cell_size = 0.0;
+    const std::vector<std::uint64_t> old = welder.slots();
+    welder = SlotTable();
+    for (std::uint64_t e : old) {
+      if (e != SlotTable::kEmpty) {
+        const std::uint32_t o = SlotTable::value_of(e);
+        welder_insert(o, weld_key(position[o].data()));
       }
     }
-    welder_place(o);
   }
-  void welder_place(std::uint32_t o) {
-    std::size_t k = home(open[o].xyz);
-    while (welder[k] != kNoIndex) k = (k + 1) & welder_mask;
-    welder[k] = o;
-  }
-  std::uint32_t welder_find(const double* p) const {
-    if (welder.empty()) return kNoIndex;
-    for (std::size_t k = home(p);; k = (k + 1) & welder_mask) {
-      if (welder[k] == kNoIndex || same_position(open[welder[k]].xyz, p)) return welder[k];
+
+  // A position as the file stores it.
+  void stored_position(const double* given, double* p) const {
+    for (int k = 0; k < 3; ++k) {
+      p[k] = float_positions ? static_cast<double>(static_cast<float>(given[k])) : given[k];
     }
-  }
-  // Backward-shift deletion, as IdMap does.
-  void welder_erase(std::uint32_t o) {
-    std::size_t hole = home(open[o].xyz);
-    while (welder[hole] != o) hole = (hole + 1) & welder_mask;
-    for (std::size_t k = (hole + 1) & welder_mask; welder[k] != kNoIndex;
-         k = (k + 1) & welder_mask) {
-      const std::size_t want = home(open[welder[k]].xyz);
-      if (((k - want) & welder_mask) >= ((k - hole) & welder_mask)) {
-        welder[hole] = welder[k];
-        hole = k;
-      }
-    }
-    welder[hole] = kNoIndex;
   }
 
   void add_vertex(const double* given) {
     const std::uint32_t number = numbered++;
     double p[3];
-    for (int k = 0; k < 3; ++k) {
-      p[k] = float_positions ? static_cast<double>(static_cast<float>(given[k])) : given[k];
-    }
-    std::uint32_t o = welder_find(p);
+    stored_position(given, p);
+    const std::uint32_t key = weld_key(p);
+    std::uint32_t o = welder_find(p, key);
     if (o == kNoIndex) {
       if (free_open.empty()) {
-        o = static_cast<std::uint32_t>(open.size());
-        open.emplace_back();
+        o = slots++;
+        if ((o >> kChunkBits) == chunks.size()) {
+          chunks.push_back(std::make_unique_for_overwrite<Open[]>(std::size_t{1} << kChunkBits));
+        }
+        node.emplace_back();
+        position.emplace_back();
       } else {
         o = free_open.back();
         free_open.pop_back();
       }
-      Open& v = open[o];
-      std::copy_n(p, 3, v.xyz);
+      Open& v = open(o);
+      std::copy_n(p, 3, position[o].begin());
       v.rep = number;
-      v.refs = 0;
+      node[o].refs = 0;
       v.wedges = 0;
       v.overflow = kNoIndex;
-      v.component = components.add();
-      v.border = borders.add();
+      node[o].component = components.add();
+      node[o].border = borders.add();
       ++open_count;
-      welder_insert(o);
+      welder_insert(o, key);
     }
-    ++open[o].refs;
+    ++node[o].refs;
     if (components.parent.size() > 2 * open_count + 4096) compact();
     open_of.insert(number, o);
   }
 
-  // Rebuilds both forests over the roots the open vertices reach.
+  // Rebuilds both forests over the roots the open vertices reach (after noting the peak: the
+  // forests shrink here, the rest never does).
   void compact() {
+    peak = std::max(peak, bytes());
     std::vector<std::uint32_t*> component_nodes, border_nodes;
-    for (Open& v : open) {
+    for (Nodes& v : node) {
       if (v.refs == 0) continue;  // a free slot
       component_nodes.push_back(&v.component);
       border_nodes.push_back(&v.border);
@@ -234,11 +391,13 @@ struct StreamStats::Impl {
 
   // Two equal welded corners, or a cross product of exactly zero (compute_stats' test, on the
   // positions as written).
-  bool degenerate(const std::array<std::uint32_t, 3>& o) const {
+  // The corners' positions are the triangle's own, rounded as stored (a welded corner has its
+  // twin's position).
+  bool degenerate(const std::array<std::uint32_t, 3>& o, const double (&p)[3][3]) const {
     if (o[0] == o[1] || o[1] == o[2] || o[0] == o[2]) return true;
-    const double* a = open[o[0]].xyz;
-    const double* b = open[o[1]].xyz;
-    const double* c = open[o[2]].xyz;
+    const double* a = p[0];
+    const double* b = p[1];
+    const double* c = p[2];
     const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
     const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
     return u[1] * v[2] - u[2] * v[1] == 0.0 && u[2] * v[0] - u[0] * v[2] == 0.0 &&
@@ -274,42 +433,51 @@ struct StreamStats::Impl {
   // A later copy of a vertex set already in the star of its first corner.
   bool duplicate(const Triangle& rep, std::uint32_t first) const {
     bool found = false;
-    for_each_wedge(open[first], [&](const Wedge& w) {
+    for_each_wedge(open(first), [&](const Wedge& w) {
       found =
           found || (w.next == rep[1] && w.prev == rep[2]) || (w.next == rep[2] && w.prev == rep[1]);
     });
     return found;
   }
 
-  void add_triangle(const Triangle& numbers, std::uint32_t group) {
+  void add_triangle(const Triangle& numbers, const std::array<const double*, 3>& xyz,
+                    std::uint32_t group) {
     ++stats.triangles;
     std::array<std::uint32_t, 3> o{};
     for (int k = 0; k < 3; ++k) {
       o[k] = open_of.find(numbers[k]);
-      if (o[k] == IdMap::kMissing) {
+      if (o[k] == NumberMap::kMissing) {
         complete = false;  // a corner already done: the counts can no longer be exact
         return;
       }
     }
-    if (degenerate(o)) {
+    double p[3][3];
+    for (int k = 0; k < 3; ++k) stored_position(xyz[k], p[k]);
+    if (degenerate(o, p)) {
       ++stats.degenerate_triangles;
       return;
     }
-    const Triangle rep{open[o[0]].rep, open[o[1]].rep, open[o[2]].rep};
+    if (edges_summed < kEdgesForCells) {
+      for (int k = 0; k < 3; ++k) {
+        edge_sum += std::abs(p[1][k] - p[0][k]);
+      }
+      if (++edges_summed == kEdgesForCells) size_cells();
+    }
+    const Triangle rep{open(o[0]).rep, open(o[1]).rep, open(o[2]).rep};
     if (duplicate(rep, o[0])) {
       ++stats.duplicate_triangles;
       return;
     }
-    for (int k = 0; k < 3; ++k) add_wedge(open[o[k]], {rep[(k + 1) % 3], rep[(k + 2) % 3], group});
-    components.unite(open[o[0]].component, open[o[1]].component);
-    components.unite(open[o[0]].component, open[o[2]].component);
+    for (int k = 0; k < 3; ++k) add_wedge(open(o[k]), {rep[(k + 1) % 3], rep[(k + 2) % 3], group});
+    components.unite(node[o[0]].component, node[o[1]].component);
+    components.unite(node[o[0]].component, node[o[2]].component);
   }
 
   void done(std::uint32_t number) {
     const std::uint32_t o = open_of.find(number);
-    if (o == IdMap::kMissing) return;
-    if (number != open[o].rep) open_of.erase(number);
-    if (--open[o].refs == 0) judge(o);
+    if (o == NumberMap::kMissing) return;
+    if (number != open(o).rep) open_of.erase(number);
+    if (--node[o].refs == 0) judge(o);
   }
 
   // v's star is complete: count its fans and its edges, then forget it. Every edge is seen from
@@ -317,10 +485,104 @@ struct StreamStats::Impl {
   // end; only a boundary edge looks up its other end, to join the two in the boundary graph
   // while both are open.
   void judge(std::uint32_t o) {
-    Open& vertex = open[o];
-    star.clear();
-    for_each_wedge(vertex, [&](const Wedge& w) { star.push_back(w); });
-    if (!star.empty()) ++stats.vertices;
+    Open& vertex = open(o);
+    std::span<const Wedge> wedges(vertex.inline_wedges, std::min(vertex.wedges, kInlineWedges));
+    if (vertex.overflow != kNoIndex) {
+      star.assign(wedges.begin(), wedges.end());
+      star.insert(star.end(), overflow[vertex.overflow].begin(), overflow[vertex.overflow].end());
+      wedges = star;
+      overflow[vertex.overflow].clear();
+      free_overflow.push_back(vertex.overflow);
+    }
+    if (!wedges.empty()) ++stats.vertices;
+    if (!judge_simple_star(o, wedges)) judge_star(o, wedges);
+    open_of.erase(vertex.rep);
+    welder_erase(o);
+    node[o].refs = 0;
+    free_open.push_back(o);
+    --open_count;
+  }
+
+  // Joins v and the other end w of a boundary edge in the boundary graph, if w is still open
+  // (else they were joined when w was judged).
+  void join_boundary(std::uint32_t o, std::uint32_t w_number) {
+    const std::uint32_t w = open_of.find(w_number);
+    if (w == NumberMap::kMissing) return;
+    const std::uint64_t before = borders.merges;
+    borders.unite(node[o].border, node[w].border);
+    boundary_merges += borders.merges - before;
+  }
+
+  // The common star, judged in one pass: no two of its triangles share their next corner or
+  // their previous one. Then each edge holds one or two of them, two running opposite ways, and
+  // "triangle j follows triangle i" (i's next corner is j's previous one) links them into
+  // chains (open fans, starting at a triangle that follows none) and cycles (closed fans). The
+  // counts are those judge_star gives; false (nothing counted) for any other star.
+  static constexpr std::size_t kSimpleStar = 16;
+  bool judge_simple_star(std::uint32_t o, std::span<const Wedge> s) {
+    const std::size_t k = s.size();
+    if (k > kSimpleStar) return false;
+    std::array<std::uint32_t, kSimpleStar> follower;  // kNoIndex: none (a boundary edge)
+    std::array<bool, kSimpleStar> preceded;
+    std::fill_n(follower.begin(), k, kNoIndex);
+    std::fill_n(preceded.begin(), k, false);
+    for (std::uint32_t i = 0; i < k; ++i) {
+      for (std::uint32_t j = i + 1; j < k; ++j) {
+        if (s[i].next == s[j].next || s[i].prev == s[j].prev) return false;
+        if (s[i].next == s[j].prev) {
+          follower[i] = j;
+          preceded[j] = true;
+        }
+        if (s[j].next == s[i].prev) {
+          follower[j] = i;
+          preceded[i] = true;
+        }
+      }
+    }
+    std::size_t links = 0, starts = 0;
+    for (std::size_t i = 0; i < k; ++i) {
+      if (follower[i] == kNoIndex) {
+        join_boundary(o, s[i].next);
+      } else {
+        ++links;
+        const std::uint32_t g1 = s[i].group, g2 = s[follower[i]].group;
+        if (g1 != g2) {
+          ++group_pairs[std::uint64_t{std::min(g1, g2)} << 32 | std::max(g1, g2)][1];
+        }
+      }
+      if (!preceded[i]) {
+        ++starts;
+        join_boundary(o, s[i].prev);
+      }
+    }
+    boundary_ends += 2 * (k - links);
+    // The triangles left over after walking the chains from their starts form the cycles.
+    std::array<bool, kSimpleStar> seen{};
+    for (std::size_t i = 0; i < k; ++i) {
+      if (preceded[i]) continue;
+      for (std::uint32_t t = static_cast<std::uint32_t>(i); t != kNoIndex; t = follower[t]) {
+        seen[t] = true;
+      }
+    }
+    std::size_t cycles = 0;
+    for (std::size_t i = 0; i < k; ++i) {
+      if (seen[i]) continue;
+      ++cycles;
+      for (std::uint32_t t = static_cast<std::uint32_t>(i); !seen[t]; t = follower[t]) {
+        seen[t] = true;
+      }
+    }
+    const std::size_t fans = starts + cycles;
+    if (fans > 1) {
+      ++stats.non_manifold_vertices;
+      ++(cycles > 0 ? stats.non_manifold_vertices_type1 : stats.non_manifold_vertices_type2);
+    }
+    return true;
+  }
+
+  // Any star: its edges grouped by their other end, fans as unions of triangles across
+  // two-triangle edges.
+  void judge_star(std::uint32_t o, std::span<const Wedge> s) {
     groups.clear();
     group_next.clear();
     group_prev.clear();
@@ -334,26 +596,21 @@ struct StreamStats::Impl {
       e.out += outgoing;
       return g;
     };
-    for (std::uint32_t i = 0; i < star.size(); ++i) {
-      group_next.push_back(touch(star[i].next, i, 1));
-      group_prev.push_back(touch(star[i].prev, i, 0));
+    for (std::uint32_t i = 0; i < s.size(); ++i) {
+      group_next.push_back(touch(s[i].next, i, 1));
+      group_prev.push_back(touch(s[i].prev, i, 0));
     }
-    const std::size_t k = star.size();
+    const std::size_t k = s.size();
     fan.resize(k);
     for (std::uint32_t i = 0; i < k; ++i) fan[i] = i;
     for (const EdgeGroup& e : groups) {
       if (e.count == 1) {
         ++boundary_ends;
-        const std::uint32_t w = open_of.find(e.w);
-        if (w != IdMap::kMissing) {  // else joined when that end was judged
-          const std::uint64_t before = borders.merges;
-          borders.unite(vertex.border, open[w].border);
-          boundary_merges += borders.merges - before;
-        }
+        join_boundary(o, e.w);
       } else if (e.count == 2) {
         const std::uint32_t a = find_root(fan, e.first), b = find_root(fan, e.second);
         if (a != b) fan[std::max(a, b)] = std::min(a, b);
-        const std::uint32_t g1 = star[e.first].group, g2 = star[e.second].group;
+        const std::uint32_t g1 = s[e.first].group, g2 = s[e.second].group;
         const bool same_way = e.out != 1;
         if (g1 == g2) {
           conflict_ends += same_way ? 1 : 0;
@@ -379,21 +636,12 @@ struct StreamStats::Impl {
         any_closed = any_closed || (fan[i] == i && !fan_open[i]);
       ++(any_closed ? stats.non_manifold_vertices_type1 : stats.non_manifold_vertices_type2);
     }
-    if (vertex.overflow != kNoIndex) {
-      overflow[vertex.overflow].clear();
-      free_overflow.push_back(vertex.overflow);
-    }
-    open_of.erase(vertex.rep);
-    welder_erase(o);
-    vertex.refs = 0;
-    free_open.push_back(o);
-    --open_count;
   }
 
   void finish(std::span<const std::uint8_t> flip) {
-    for (std::uint32_t o = 0; o < open.size(); ++o) {
-      if (open[o].refs > 0) {
-        open[o].refs = 1;
+    for (std::uint32_t o = 0; o < slots; ++o) {
+      if (node[o].refs > 0) {
+        node[o].refs = 1;
         judge(o);
       }
     }
@@ -412,11 +660,12 @@ struct StreamStats::Impl {
   std::uint64_t bytes() const {
     std::uint64_t overflowing = 0;
     for (const std::vector<Wedge>& list : overflow) overflowing += list.capacity() * sizeof(Wedge);
-    return open.capacity() * sizeof(Open) + overflowing +
-           (welder.capacity() + free_open.capacity() + components.parent.capacity() +
+    return chunks.size() * (sizeof(Open) << kChunkBits) + node.capacity() * sizeof(Nodes) +
+           position.capacity() * sizeof(position[0]) + overflowing +
+           (2 * welder.capacity() + free_open.capacity() + components.parent.capacity() +
             borders.parent.capacity()) *
                sizeof(std::uint32_t) +
-           open_of.size() * 16 + group_pairs.size() * 48;
+           open_of.bytes() + group_pairs.size() * 48;
   }
 };
 
@@ -424,14 +673,16 @@ StreamStats::StreamStats(MeshSink& next, bool float_positions)
     : impl_(std::make_unique<Impl>(next, float_positions)) {}
 StreamStats::~StreamStats() = default;
 
+// The next sink first: it reads the position anyway (the writer stores it), so the counter finds
+// it in cache and a profile charges the counter only for its own work.
 void StreamStats::vertex(Index id, const double xyz[3]) {
-  impl_->add_vertex(xyz);
   impl_->next.vertex(id, xyz);
+  impl_->add_vertex(xyz);
 }
 
 void StreamStats::triangle(const Triangle& corners, const std::array<const double*, 3>& xyz,
                            std::uint32_t group) {
-  impl_->add_triangle(corners, group);
+  impl_->add_triangle(corners, xyz, group);
   impl_->next.triangle(corners, xyz, group);
 }
 
@@ -452,7 +703,7 @@ bool StreamStats::complete() const {
   return impl_->complete;
 }
 std::uint64_t StreamStats::peak_bytes() const {
-  return impl_->bytes();
+  return std::max(impl_->peak, impl_->bytes());
 }
 
 }  // namespace g2s

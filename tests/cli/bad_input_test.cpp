@@ -91,7 +91,10 @@ class BadInput : public g2s::test_support::FolderTest {
  protected:
   // Runs the g2s CLI with `args`; a run past `seconds` is killed and fails the test as a hang.
   CliRun run(const std::vector<std::string>& args, double seconds = 60.0) {
-    return g2s::test_support::run_cli(dir_, args, {.seconds = seconds, .as_nobody = unprivileged_});
+    g2s::test_support::CliOptions options;
+    options.seconds = seconds;
+    options.as_nobody = unprivileged_;
+    return g2s::test_support::run_cli(dir_, args, options);
   }
 
   // `g2s mesh input -o output` plus extra arguments.

@@ -33,7 +33,9 @@ class PipelineFaults : public ::testing::Test {
   // (0: no limit).
   g2s::test_support::CliRun run(const std::vector<std::string>& args,
                                 rlim_t file_size_limit = 0) const {
-    return g2s::test_support::run_cli(dir_, args, {.file_size_limit = file_size_limit});
+    g2s::test_support::CliOptions options;
+    options.file_size_limit = file_size_limit;
+    return g2s::test_support::run_cli(dir_, args, options);
   }
 
   // Starts the CLI, sends `signal` as soon as `ready()` holds (checked every few ms), returns its

@@ -38,6 +38,9 @@ struct CliOptions {
   // Files the run writes may not grow past this many bytes (0: no limit). SIGXFSZ is ignored,
   // so writes fail with EFBIG, as on a full disk.
   rlim_t file_size_limit = 0;
+  // A command the run goes through, with its arguments (program by absolute path), such as
+  // /usr/bin/time measuring its peak memory; empty: none.
+  std::vector<std::string> prefix;
 };
 
 // `g2s ARGS` started in a child process whose working folder is `dir`. Its stdout and stderr go
@@ -61,12 +64,13 @@ class CliChild {
         argv.push_back(const_cast<char*>(a));
       }
     }
+    for (const std::string& a : options.prefix) argv.push_back(const_cast<char*>(a.c_str()));
     for (const char* a : {"/usr/bin/timeout", "--foreground", "0", G2S_CLI_PATH}) {
       argv.push_back(const_cast<char*>(a));
     }
     for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
     argv.push_back(nullptr);
-    const char* program = options.as_nobody ? "/usr/bin/setpriv" : "/usr/bin/timeout";
+    const char* program = options.as_nobody ? "/usr/bin/setpriv" : argv.front();
     const int out = ::fileno(out_), err = ::fileno(err_);
     const rlimit limit{options.file_size_limit, options.file_size_limit};
     pid_ = ::fork();
