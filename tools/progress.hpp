@@ -12,7 +12,19 @@
 
 namespace g2s::cli {
 
+// The process's own peak resident memory: VmHWM of /proc/self/status. Not ru_maxrss, which Linux
+// carries over exec from the process that started g2s (a Python or a test process holding
+// hundreds of megabytes would be reported as g2s's peak); ru_maxrss only where /proc is missing.
 inline double peak_rss_mb() {
+  if (std::FILE* status = std::fopen("/proc/self/status", "r")) {
+    char line[256];
+    double kib = -1;
+    while (std::fgets(line, sizeof line, status)) {
+      if (std::sscanf(line, "VmHWM: %lf kB", &kib) == 1) break;
+    }
+    std::fclose(status);
+    if (kib >= 0) return kib / 1024.0;
+  }
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux

@@ -195,6 +195,25 @@ TEST_F(HostileCli, FarStrayPointNamesFloatPrecision) {
 }
 
 // Items 7 and 9: values that cannot work are refused in one short line saying what is valid.
+// The peak memory g2s reports is its own, even when the process that started it held far more
+// (Linux carries ru_maxrss over exec): here a Python process touches 400 MB and then becomes g2s.
+TEST_F(HostileCli, ReportedPeakIsNotTheStartingProcesss) {
+  if (!fs::exists("/usr/bin/python3")) GTEST_SKIP() << "no /usr/bin/python3";
+  const fs::path torus = cloud("torus.ply", "torus", "2000");
+  g2s::test_support::CliOptions options;
+  // The runner appends "timeout --foreground 0 g2s ARGS": the script execs g2s itself, dropping
+  // the timeout, so that g2s inherits the script's memory high-water mark.
+  options.prefix = {"/usr/bin/python3", "-c",
+                    "import os, sys\n"
+                    "held = bytearray(400 << 20)\n"
+                    "for i in range(0, len(held), 4096): held[i] = 1\n"
+                    "os.execv(sys.argv[4], sys.argv[4:])"};
+  const CliRun r = g2s::test_support::run_cli(
+      dir_, {"mesh", torus.string(), "-o", path("torus.stl").string(), "--json"}, options);
+  ASSERT_EQ(r.code, kOk) << r.err;
+  EXPECT_LT(g2s::test_support::json_number(r.out, "peak_rss_mb"), 200.0) << r.out;
+}
+
 TEST_F(HostileCli, OptionsThatCannotWork) {
   const std::string in = cloud("in.ply", "sphere", "2000").string();
   const std::string out = path("m.ply").string();

@@ -47,9 +47,8 @@ struct CliOptions {
 // to unnamed temporary files, so the folder holds only what g2s writes there.
 //
 // g2s is started through `timeout --foreground 0` (no time limit), which forks it from a small
-// process and passes signals and the exit status through, as a shell does. Started straight from
-// this process, g2s would report this process's memory as its own peak: Linux carries
-// ru_maxrss over exec from the memory of the process that forked it.
+// process and passes signals and the exit status through, as a shell does (g2s's own peak
+// memory no longer depends on it: HostileCli.ReportedPeakIsNotTheStartingProcesss).
 class CliChild {
  public:
   CliChild(const std::filesystem::path& dir, const std::vector<std::string>& args,
