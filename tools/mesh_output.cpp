@@ -101,7 +101,7 @@ std::string why_no_surface(const TileSource& source) {
       g2s::why_no_surface(source.point_count(), [&source](const PointRun& visit) {
         for (std::size_t t = 0; t < source.tiles().size(); ++t) visit(source.load(t).xyz);
       });
-  if (why.empty()) return why;
+  if (why.empty()) return {};
   const std::string too_wide = why_tile_too_wide(source);
   return too_wide.empty() ? why : too_wide;
 }
