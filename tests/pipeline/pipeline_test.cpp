@@ -55,7 +55,8 @@ void expect_clean(const g2s::MeshStats& s) {
 // tiling (a few tiles; both adapt the search to each tile's own spacing, which a single tile
 // over a cloud of two densities cannot): boundary edges within 3% (plus one small hole's border
 // for clouds whose mesh is closed or almost), holes within 10%, since a seam fills only
-// the holes its band reaches (table-mug, 52 tiles: 233 against 213; docs/pipeline.md).
+// the holes its band reaches (table-mug, 52 tiles: 233 against 213; docs/pipeline.md, "Holes and
+// the tiling").
 void expect_close_to(const g2s::MeshStats& tiled, const g2s::MeshStats& usual) {
   EXPECT_LE(static_cast<double>(tiled.boundary_edges),
             static_cast<double>(usual.boundary_edges) * 1.03 + 20);
