@@ -29,6 +29,10 @@ struct HoleScratch {
     std::uint16_t right;  // the apex on chord k-j
   };
   std::vector<State> states;
+  // Per chord i-j: its apexes k with a filling, by decreasing fold_cos (count[i*n + j] of them
+  // from by_fold[(i*n + j)*n]), so that a parent's search can stop at the first that cannot win.
+  std::vector<std::uint16_t> by_fold;
+  std::vector<std::uint16_t> count;
   std::vector<std::size_t> stack;
 };
 
@@ -48,7 +52,8 @@ inline double triangle_area(const Vec3f& a, const Vec3f& b, const Vec3f& c) {
 // triangulation needs a forbidden chord, a forbidden triangle or a degenerate one. The sharpest
 // fold is the gentlest any triangulation has (exact); among those, the area is made small
 // greedily.
-// O(n^4) time, O(n^3) scratch: loops are short (the grower's limit is max_hole_edges).
+// O(n^4) time at worst, far less as a rule (a parent's search stops at the first apex whose own
+// fold cannot win), O(n^3) scratch: loops are short (the grower's limit is max_hole_edges).
 template <class ChordOk, class TriangleOk>
 std::optional<double> triangulate_loop(std::span<const Vec3f> points, std::span<const Index> loop,
                                        std::span<const Vec3> around, ChordOk&& chord_ok,
@@ -58,7 +63,10 @@ std::optional<double> triangulate_loop(std::span<const Vec3f> points, std::span<
   constexpr double kNone = -2;  // below every cosine
   if (n < 3 || around.size() != n) return std::nullopt;
   using State = HoleScratch::State;
-  scratch.states.assign(n * n * n, State{kNone, 0, Vec3{0, 0, 0}, 0, 0});
+  // Only the states listed in by_fold are read, so neither array needs clearing.
+  if (scratch.states.size() < n * n * n) scratch.states.resize(n * n * n);
+  if (scratch.by_fold.size() < n * n * n) scratch.by_fold.resize(n * n * n);
+  scratch.count.assign(n * n, 0);
   const auto state = [&](std::size_t i, std::size_t j, std::size_t k) -> State& {
     return scratch.states[(i * n + j) * n + k];
   };
@@ -74,9 +82,11 @@ std::optional<double> triangulate_loop(std::span<const Vec3f> points, std::span<
   const auto side = [&](std::size_t a, std::size_t b, const Vec3& normal) {
     if (b == a + 1) return Side{dot(normal, around[a]), 0, 0};
     Side best{kNone, 0, 0};
-    for (std::size_t c = a + 1; c < b; ++c) {
+    const std::uint16_t* apexes = &scratch.by_fold[(a * n + b) * n];
+    for (std::size_t r = 0; r < scratch.count[a * n + b]; ++r) {
+      const std::size_t c = apexes[r];
       const State& s = state(a, b, c);
-      if (s.fold_cos == kNone) continue;
+      if (s.fold_cos < best.fold_cos) break;  // nor can any after it
       const double fold_cos = std::min(s.fold_cos, dot(normal, s.normal));
       if (better(fold_cos, s.area, best.fold_cos, best.area)) {
         best = Side{fold_cos, s.area, static_cast<std::uint16_t>(c)};
@@ -100,15 +110,22 @@ std::optional<double> triangulate_loop(std::span<const Vec3f> points, std::span<
         state(i, j, k) =
             State{std::min(left.fold_cos, right.fold_cos),
                   left.area + right.area + 0.5 * twice_area, normal, left.apex, right.apex};
+        scratch.by_fold[(i * n + j) * n + scratch.count[i * n + j]++] =
+            static_cast<std::uint16_t>(k);
       }
+      std::uint16_t* apexes = &scratch.by_fold[(i * n + j) * n];
+      std::sort(apexes, apexes + scratch.count[i * n + j], [&](std::uint16_t x, std::uint16_t y) {
+        const double fx = state(i, j, x).fold_cos, fy = state(i, j, y).fold_cos;
+        return fx > fy || (fx == fy && x < y);
+      });
     }
   }
   // The whole loop: chord 0-(n-1) is the closing loop edge.
   double best_cos = kNone, best_area = 0;
   std::size_t top = 0;
-  for (std::size_t k = 1; k + 1 < n; ++k) {
+  for (std::size_t r = 0; r < scratch.count[n - 1]; ++r) {
+    const std::size_t k = scratch.by_fold[(n - 1) * n + r];
     const State& s = state(0, n - 1, k);
-    if (s.fold_cos == kNone) continue;
     const double fold_cos = std::min(s.fold_cos, dot(s.normal, around[n - 1]));
     if (better(fold_cos, s.area, best_cos, best_area))
       best_cos = fold_cos, best_area = s.area, top = k;
