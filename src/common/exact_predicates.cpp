@@ -181,7 +181,12 @@ bool to_integers(const double* d, int n, int bits, std::int64_t* out) {
   }
   if (high - low + 1 > bits) return false;
   for (int k = 0; k < n; ++k) {
-    // exponent - low >= -(trailing zeros of the mantissa), so a right shift drops only zeros.
+    if (b[k].mantissa == 0) {
+      out[k] = 0;
+      continue;
+    }
+    // exponent - low >= -(trailing zeros of the mantissa), so a right shift drops only zeros;
+    // and the shifted value has fewer than `bits` bits, so no shift reaches 64.
     const int shift = b[k].exponent - low;
     out[k] = shift >= 0 ? b[k].mantissa * (std::int64_t{1} << shift)
                         : b[k].mantissa / (std::int64_t{1} << -shift);

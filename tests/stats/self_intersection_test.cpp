@@ -209,6 +209,14 @@ TEST(ExactPredicates, TinyOffsetsFromLargeCoordinates) {
   EXPECT_EQ(g2s::exact::orient3d(a, b, c, below), -1);
   EXPECT_EQ(g2s::exact::orient3d(a, b, c, on), 0);
   EXPECT_TRUE(g2s::exact::collinear(a, a, b));
+  // Zero differences (repeated points, shared coordinates) on the integer path and beside it.
+  EXPECT_EQ(g2s::exact::orient3d(on, on, on, on), 0);
+  const double o[3] = {0, 0, 0}, x[3] = {1, 0, 0}, y[3] = {0, 1, 0}, half[3] = {0, 0, 0.5};
+  const double tiny[3] = {0, 0, 1e-300};
+  EXPECT_EQ(g2s::exact::orient3d(o, x, y, half), -g2s::exact::orient3d(o, y, x, half));
+  EXPECT_NE(g2s::exact::orient3d(o, x, y, half), 0);
+  EXPECT_EQ(g2s::exact::orient3d(o, x, y, tiny), g2s::exact::orient3d(o, x, y, half));
+  EXPECT_EQ(g2s::exact::orient2d(o, o, o, 0, 1), 0);
   const double m[3] = {0.5, 0.5, 0.5}, n[3] = {1.5, 1.5, 1.5}, p[3] = {2.5, 2.5, 2.5};
   EXPECT_TRUE(g2s::exact::collinear(m, n, p));
   const double q[3] = {2.5, 2.5, std::nextafter(2.5, 3.0)};
