@@ -38,14 +38,14 @@ bool padded_circumball(const Vec3& a, const Vec3& b, const Vec3& c, Ball& out) {
   return true;
 }
 
-bool in_empty_ball(const HashGrid& grid, const Triangle& t) {
+bool in_empty_ball(const HashGrid& grid, const Triangle& t, std::span<const std::uint8_t> vertex) {
   Ball ball;
   if (!padded_circumball(grid.position(t[0]), grid.position(t[1]), grid.position(t[2]), ball)) {
     return false;
   }
   bool empty = true;
   grid.for_each_in_ball(ball.centre, std::sqrt(ball.radius2), [&](std::uint32_t j, double) {
-    if (j != t[0] && j != t[1] && j != t[2]) empty = false;
+    if (j != t[0] && j != t[1] && j != t[2] && (vertex.empty() || vertex[j])) empty = false;
   });
   return empty;
 }

@@ -19,14 +19,15 @@ namespace g2s::detail {
 // True when the triangle's corners lie on one line (exactly).
 bool degenerate(std::span<const Vec3f> points, const Triangle& t);
 
-// True when the ball through the triangle's corners centred in its plane holds no other point of
-// `grid`, none even within 1e-8 of its radius (far beyond the rounding of its centre). Such a
-// triangle is a face of the Delaunay tetrahedralization of the grid's points, and two of them
+// True when the ball through the triangle's corners centred in its plane holds no other vertex
+// (a point of `grid` with vertex[j] set; empty: every point), none even within 1e-8 of its
+// radius (far beyond the rounding of its centre). Two such triangles, among those vertices,
 // never cross: the difference of the powers of a point with respect to their two spheres is an
 // affine function, positive on one triangle's other corners and negative on the other's, so the
-// triangles can meet only where it is zero, in the corners they share. Only triangles without
-// this certificate need to be searched for crossings, and on a clean scan they are few.
-bool in_empty_ball(const HashGrid& grid, const Triangle& t);
+// triangles can meet only where it is zero, in the corners they share. Points no triangle uses
+// play no part, so noise left out of the mesh does not spoil the certificate. Only triangles
+// without it need to be searched for crossings, and on a clean scan they are few.
+bool in_empty_ball(const HashGrid& grid, const Triangle& t, std::span<const std::uint8_t> vertex);
 
 // The ball through a, b and c centred in their plane, its radius padded by 1e-8 of itself and of
 // the centre's coordinates (far beyond the rounding of the centre): a point outside it is

@@ -364,13 +364,16 @@ class Grower {
     return dead;
   }
 
-  // The triangles not certified crossing-free by an empty ball through their corners, ascending.
+  // The triangles not certified crossing-free by a ball through their corners empty of the run's
+  // vertices (every point a triangle uses; this runs before any removal), ascending.
   std::vector<std::uint32_t> uncertified() const {
+    std::vector<std::uint8_t> vertex(grid_.size());
+    for (std::uint32_t v = 0; v < grid_.size(); ++v) vertex[v] = used(v);
     std::vector<std::uint8_t> empty(triangles_.size(), 0);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, triangles_.size(), 1024),
                       [&](const tbb::blocked_range<std::size_t>& range) {
                         for (std::size_t t = range.begin(); t < range.end(); ++t) {
-                          empty[t] = detail::in_empty_ball(grid_, triangles_[t]);
+                          empty[t] = detail::in_empty_ball(grid_, triangles_[t], vertex);
                         }
                       });
     std::vector<std::uint32_t> rest;

@@ -102,7 +102,7 @@ TEST(Crossings, TrianglesInEmptyBallsNeverCrossEachOther) {
   }
   std::vector<Triangle> certified;
   for (const Triangle& t : triangles) {
-    if (detail::in_empty_ball(grid, t)) certified.push_back(t);
+    if (detail::in_empty_ball(grid, t, {})) certified.push_back(t);
   }
   ASSERT_GT(certified.size(), 100u);
   ASSERT_LT(certified.size(), triangles.size() / 2);
@@ -127,17 +127,27 @@ TEST(Crossings, AFourthPointOnTheSphereDeniesTheCertificate) {
   const std::vector<float> square = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
   const HashGrid on_circle(square, {});
   for (const Triangle& t : {Triangle{0, 1, 2}, Triangle{0, 2, 3}, Triangle{0, 1, 3}}) {
-    EXPECT_FALSE(detail::in_empty_ball(on_circle, t));
+    EXPECT_FALSE(detail::in_empty_ball(on_circle, t, {}));
+  }
+  // A fourth point that is no vertex (left out of the mesh) does not count.
+  for (Index left_out = 0; left_out < 4; ++left_out) {
+    std::vector<std::uint8_t> vertex(4, 1);
+    vertex[left_out] = 0;
+    Triangle t;
+    for (Index k = 0, n = 0; k < 4; ++k) {
+      if (k != left_out) t[n++] = k;
+    }
+    EXPECT_TRUE(detail::in_empty_ball(on_circle, t, vertex));
   }
   std::vector<float> kite = square;
   kite[10] = 1.01f;  // the fourth corner just outside the circle of the first three
   const HashGrid off_circle(kite, {});
   Index at[4];  // grid index of each input point
   for (Index i = 0; i < 4; ++i) at[off_circle.source(i)] = i;
-  EXPECT_TRUE(detail::in_empty_ball(off_circle, {at[0], at[1], at[2]}));
-  EXPECT_TRUE(detail::in_empty_ball(off_circle, {at[0], at[2], at[3]}));
-  EXPECT_FALSE(detail::in_empty_ball(off_circle, {at[0], at[1], at[3]}));
-  EXPECT_FALSE(detail::in_empty_ball(off_circle, {at[1], at[2], at[3]}));
+  EXPECT_TRUE(detail::in_empty_ball(off_circle, {at[0], at[1], at[2]}, {}));
+  EXPECT_TRUE(detail::in_empty_ball(off_circle, {at[0], at[2], at[3]}, {}));
+  EXPECT_FALSE(detail::in_empty_ball(off_circle, {at[0], at[1], at[3]}, {}));
+  EXPECT_FALSE(detail::in_empty_ball(off_circle, {at[1], at[2], at[3]}, {}));
 }
 
 }  // namespace
