@@ -390,12 +390,13 @@ class Grower {
     return tri;
   }
 
-  // Closes every hole whose boundary loop has at most max_hole_edges edges with the least-area
-  // triangulation over the loop's points, where no triangle of it folds beyond the fold limit
-  // from its neighbours, no edge gets a third triangle and none crosses a live triangle. The
-  // loops follow the open edges as the triangles around face; at a point with several fans
-  // each edge in goes on by the first free edge out counter-clockwise from it (next_open_edges),
-  // so the gap between two fans is a hole of its own, and filling it makes the two fans one.
+  // Closes every hole whose boundary loop has at most max_hole_edges edges with the
+  // triangulation over the loop's points whose sharpest fold is gentlest (triangulate_loop),
+  // where no edge gets a third triangle and no triangle crosses or repeats a live one or covers
+  // a context point (fill_fits). The loops follow the open edges as the triangles around face;
+  // at a point with several fans each edge in goes on by the first free edge out
+  // counter-clockwise from it (next_open_edges), so the gap between two fans is a hole of its
+  // own, and filling it makes the two fans one; a loop through a point twice is split there.
   // Appends the filling triangles to triangles_.
   void fill_holes() {
     std::optional<detail::TriangleCells> cells;  // of the grown triangles, once a loop needs them
