@@ -196,8 +196,9 @@ void add_mesh_options(CLI::App& cmd, PipelineOptions& options) {
       "Leave gaps of three open edges open after growth (the paper's G2S alone)");
   cmd.add_option("--max-hole-edges", options.mesh.max_hole_edges,
                  "Once grown, close holes whose boundary loop has at most this many edges, with "
-                 "triangles over the loop's own points (default 30; 0 leaves every hole)")
-      ->check(count_range(0, 200));
+                 "triangles over the loop's own points (default 30, at most 100; 0 leaves every "
+                 "hole)")
+      ->check(count_range(0, MeshOptions::kMaxHoleEdges));
   cmd.add_flag(
       "--no-orient", [&options](std::int64_t) { options.mesh.orient = false; },
       "Keep each component's seed orientation instead of facing closed ones outward");

@@ -31,8 +31,10 @@ struct MeshOptions {
   bool close_gaps = true;
   // Once growth is over, close every hole whose boundary loop has at most this many edges with
   // triangles over the loop's own points, where the result stays manifold, consistently
-  // oriented, unfolded and free of crossings (docs/algorithm.md, "Hole filling"); 0: none.
+  // oriented and free of crossings (docs/algorithm.md, "Hole filling"); 0: none. At most
+  // kMaxHoleEdges counts (a loop of n edges costs O(n^3) memory and O(n^4) time to fill).
   int max_hole_edges = 30;
+  static constexpr int kMaxHoleEdges = 100;
   // Orient each closed component outward (open, mostly horizontal ones up; see
   // docs/algorithm.md §6).
   bool orient = true;

@@ -410,7 +410,8 @@ class Grower {
       }
     }
     const std::vector<std::uint32_t> next = next_open_edges(open);
-    const std::size_t max_edges = static_cast<std::size_t>(options_.max_hole_edges);
+    const auto max_edges =
+        static_cast<std::size_t>(std::min(options_.max_hole_edges, MeshOptions::kMaxHoleEdges));
     // The loops first, as runs of open edges (loop_edges[begin, begin + length)), each with its
     // component (the surface piece it borders) and whether it can be filled (every point
     // fillable, the loop closed). A loop that passes a point twice is split there into loops
