@@ -1,5 +1,6 @@
-// Crossing triangles (crossings.hpp): triangles filed by the cell of their box's lower corner, in
-// two sizes of cell; the pair test is the exact one of common/triangle_intersection.hpp.
+// Crossing triangles (crossings.hpp): the empty-ball certificate, and triangles filed by the cell
+// of their box's lower corner in levels of cells; the pair test is the exact one of
+// common/triangle_intersection.hpp, after the power test of `apart`.
 #include "grow/crossings.hpp"
 
 #include <tbb/blocked_range.h>
@@ -53,11 +54,11 @@ bool in_empty_ball(const HashGrid& grid, const Triangle& t, std::span<const std:
 namespace {
 using Pairs = std::vector<std::pair<std::uint32_t, std::uint32_t>>;
 
+// The pairs each thread found (every pair by one thread, once), sorted.
 Pairs sorted_union(tbb::enumerable_thread_specific<Pairs>& found) {
   Pairs pairs;
   for (const Pairs& part : found) pairs.insert(pairs.end(), part.begin(), part.end());
   std::sort(pairs.begin(), pairs.end());
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
   return pairs;
 }
 }  // namespace

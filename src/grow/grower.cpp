@@ -614,9 +614,11 @@ class Grower {
     const Vec3f hi{std::max({p0.x, p1.x, p2.x}), std::max({p0.y, p1.y, p2.y}),
                    std::max({p0.z, p1.z, p2.z})};
     // Points this run may not use (a seam's context: tiles still to come) must not lie in
-    // the triangle's smallest ball: the surface may yet be meshed over them.
+    // the triangle's circumball: the surface may yet be meshed over them. The same (padded)
+    // ball settles most neighbours by the power test (TriangleCells::apart).
     Ball ball;
-    if (!circumball(grid_.position(t[0]), grid_.position(t[1]), grid_.position(t[2]), ball)) {
+    if (!detail::padded_circumball(grid_.position(t[0]), grid_.position(t[1]), grid_.position(t[2]),
+                                   ball)) {
       return false;
     }
     if (!growable_.empty()) {
@@ -626,15 +628,12 @@ class Grower {
       });
       if (covers_context) return false;
     }
-    Ball padded;
-    const bool has_ball = detail::padded_circumball(grid_.position(t[0]), grid_.position(t[1]),
-                                                    grid_.position(t[2]), padded);
     bool crosses = false;
     cells.for_each_near(lo, hi, [&](std::uint32_t other) {
       if (crosses) return;
       const Triangle& o = triangles_[other];
       crosses = std::is_permutation(o.begin(), o.end(), t.begin()) ||
-                (!cells.degenerate(other) && !(has_ball && cells.apart(t, padded, other)) &&
+                (!cells.degenerate(other) && !cells.apart(t, ball, other) &&
                  detail::triangles_cross(grid_.points(), t, o));
     });
     return !crosses;
