@@ -1,6 +1,6 @@
-// Crossing triangles (crossings.hpp): the empty-ball certificate, and triangles filed by the cell
-// of their box's lower corner in levels of cells; the pair test is the exact one of
-// common/triangle_intersection.hpp, after the power test of `apart`.
+// Crossing triangles (crossings.hpp): the search by the empty-ball argument over the triangles on
+// each vertex, and triangles filed by the cell of their box's lower corner in levels of cells;
+// the pair test is the exact one of common/triangle_intersection.hpp.
 #include "grow/crossings.hpp"
 
 #include <tbb/blocked_range.h>
@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "common/exact_predicates.hpp"
@@ -39,18 +40,6 @@ bool padded_circumball(const Vec3& a, const Vec3& b, const Vec3& c, Ball& out) {
   return true;
 }
 
-bool in_empty_ball(const HashGrid& grid, const Triangle& t, std::span<const std::uint8_t> vertex) {
-  Ball ball;
-  if (!padded_circumball(grid.position(t[0]), grid.position(t[1]), grid.position(t[2]), ball)) {
-    return false;
-  }
-  bool empty = true;
-  grid.for_each_in_ball(ball.centre, std::sqrt(ball.radius2), [&](std::uint32_t j, double) {
-    if (j != t[0] && j != t[1] && j != t[2] && (vertex.empty() || vertex[j])) empty = false;
-  });
-  return empty;
-}
-
 namespace {
 using Pairs = std::vector<std::pair<std::uint32_t, std::uint32_t>>;
 
@@ -62,6 +51,124 @@ Pairs sorted_union(tbb::enumerable_thread_specific<Pairs>& found) {
   return pairs;
 }
 }  // namespace
+
+RunCrossings find_crossings(const HashGrid& grid, std::span<const Triangle> triangles) {
+  const std::size_t n = grid.size();
+  // Per vertex, the triangles on it: the corners sorted by vertex (counting sort).
+  std::vector<std::uint32_t> star_begin(n + 1, 0), star(3 * triangles.size());
+  for (const Triangle& t : triangles) {
+    for (const Index v : t) ++star_begin[v + 1];
+  }
+  for (std::size_t v = 0; v < n; ++v) star_begin[v + 1] += star_begin[v];
+  {
+    std::vector<std::uint32_t> at(star_begin.begin(), star_begin.end() - 1);
+    for (std::uint32_t t = 0; t < triangles.size(); ++t) {
+      for (const Index v : triangles[t]) star[at[v]++] = t;
+    }
+  }
+  const auto is_vertex = [&](Index v) { return star_begin[v] != star_begin[v + 1]; };
+  const auto ball_of = [&](const Triangle& t, Ball& ball) {
+    return padded_circumball(grid.position(t[0]), grid.position(t[1]), grid.position(t[2]), ball);
+  };
+  // Whether each triangle has a ball, and whether it holds a vertex (uncertified).
+  enum : std::uint8_t { kNoBall, kCertified, kUncertified };
+  std::vector<std::uint8_t> kind(triangles.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, triangles.size(), 1024),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t t = range.begin(); t < range.end(); ++t) {
+                        const Triangle& tri = triangles[t];
+                        Ball ball;
+                        if (!ball_of(tri, ball)) {
+                          kind[t] = kNoBall;
+                          continue;
+                        }
+                        bool empty = true;
+                        grid.for_each_in_ball(
+                            ball.centre, std::sqrt(ball.radius2), [&](std::uint32_t j, double) {
+                              if (j != tri[0] && j != tri[1] && j != tri[2] && is_vertex(j)) {
+                                empty = false;
+                              }
+                            });
+                        kind[t] = empty ? kCertified : kUncertified;
+                      }
+                    });
+  RunCrossings result;
+  for (std::uint32_t t = 0; t < triangles.size(); ++t) {
+    if (kind[t] == kNoBall) result.without_ball.push_back(t);
+  }
+  // Each uncertified triangle against the triangles on the vertices in its ball. A pair where
+  // each ball holds a corner of the other is met from both sides; the larger index leaves it
+  // to the smaller.
+  const auto box_of = [&](const Triangle& t) {
+    const Vec3f &p0 = grid.point(t[0]), &p1 = grid.point(t[1]), &p2 = grid.point(t[2]);
+    return std::array<Vec3f, 2>{Vec3f{std::min({p0.x, p1.x, p2.x}), std::min({p0.y, p1.y, p2.y}),
+                                      std::min({p0.z, p1.z, p2.z})},
+                                Vec3f{std::max({p0.x, p1.x, p2.x}), std::max({p0.y, p1.y, p2.y}),
+                                      std::max({p0.z, p1.z, p2.z})}};
+  };
+  const auto holds_corner_of = [&](const Triangle& s, const Triangle& t) {
+    Ball ball;
+    ball_of(s, ball);
+    const HashGrid::BallQuery query(grid, ball.centre, std::sqrt(ball.radius2));  // as s's search
+    for (const Index v : t) {
+      if (v != s[0] && v != s[1] && v != s[2] && query.visits(grid, v)) return true;
+    }
+    return false;
+  };
+  struct Scratch {
+    std::vector<Index> inside;
+    std::vector<std::uint32_t> near;
+  };
+  tbb::enumerable_thread_specific<Pairs> found;
+  tbb::enumerable_thread_specific<Scratch> scratch;
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, triangles.size(), 1024),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        Pairs& pairs = found.local();
+        Scratch& local = scratch.local();
+        for (std::size_t t = range.begin(); t < range.end(); ++t) {
+          if (kind[t] != kUncertified) continue;
+          const auto id = static_cast<std::uint32_t>(t);
+          const Triangle& tri = triangles[t];
+          Ball ball;
+          ball_of(tri, ball);
+          local.inside.clear();
+          grid.for_each_in_ball(ball.centre, std::sqrt(ball.radius2), [&](std::uint32_t j, double) {
+            if (j != tri[0] && j != tri[1] && j != tri[2] && is_vertex(j)) {
+              local.inside.push_back(j);
+            }
+          });
+          const auto box = box_of(tri);
+          local.near.clear();
+          for (const Index v : local.inside) {
+            for (std::uint32_t s = star_begin[v]; s < star_begin[v + 1]; ++s) {
+              const std::uint32_t other = star[s];
+              if (other == id || kind[other] == kNoBall) continue;
+              const auto other_box = box_of(triangles[other]);
+              if (other_box[0].x > box[1].x || box[0].x > other_box[1].x ||
+                  other_box[0].y > box[1].y || box[0].y > other_box[1].y ||
+                  other_box[0].z > box[1].z || box[0].z > other_box[1].z) {
+                continue;
+              }
+              local.near.push_back(other);
+            }
+          }
+          std::sort(local.near.begin(), local.near.end());
+          local.near.erase(std::unique(local.near.begin(), local.near.end()), local.near.end());
+          for (const std::uint32_t other : local.near) {
+            if (other < id && kind[other] == kUncertified &&
+                holds_corner_of(triangles[other], tri)) {
+              continue;
+            }
+            if (triangles_cross(grid.points(), tri, triangles[other])) {
+              pairs.push_back({std::min(id, other), std::max(id, other)});
+            }
+          }
+        }
+      });
+  result.pairs = sorted_union(found);
+  return result;
+}
 
 Pairs TriangleCells::crossing_pairs() const {
   const Level& first = levels_[0];
@@ -129,31 +236,6 @@ bool TriangleCells::apart(const Triangle& t, const Ball& ball, std::uint32_t oth
     return true;
   };
   return outside(t, o, other_ball) && outside(o, t, ball);
-}
-
-Pairs TriangleCells::crossing_pairs_involving(std::span<const std::uint32_t> focus) const {
-  std::vector<std::uint8_t> focused(triangles_.size(), 0);
-  for (const std::uint32_t t : focus) focused[t] = 1;
-  tbb::enumerable_thread_specific<Pairs> found;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, focus.size(), 256),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      Pairs& pairs = found.local();
-                      for (std::size_t f = range.begin(); f < range.end(); ++f) {
-                        const std::uint32_t t = focus[f];
-                        if (degenerate_[t]) continue;
-                        for_each_near(boxes_[t].lo, boxes_[t].hi, [&](std::uint32_t other) {
-                          // A pair of two focused triangles is tested from the smaller.
-                          if (other == t || degenerate_[other] || (focused[other] && other < t)) {
-                            return;
-                          }
-                          if (apart(t, other)) return;
-                          if (triangles_cross(points_, triangles_[t], triangles_[other])) {
-                            pairs.push_back({std::min(t, other), std::max(t, other)});
-                          }
-                        });
-                      }
-                    });
-  return sorted_union(found);
 }
 
 std::int64_t TriangleCells::Level::coord(float v) const {

@@ -1,7 +1,8 @@
 // Crossing triangles among the triangles of one growth run: pairs that meet other than in a
 // shared corner or a shared edge. The grower removes one triangle of each pair once growth is
-// over, and checks the triangles it fills holes with, so that no mesh it makes crosses itself
-// (docs/algorithm.md, "No crossing triangles").
+// over (find_crossings), and checks the triangles it fills holes with against the rest
+// (TriangleCells), so that no mesh it makes crosses itself (docs/algorithm.md, "No crossing
+// triangles").
 #pragma once
 
 #include <algorithm>
@@ -19,16 +20,6 @@ namespace g2s::detail {
 // True when the triangle's corners lie on one line (exactly).
 bool degenerate(std::span<const Vec3f> points, const Triangle& t);
 
-// True when the ball through the triangle's corners centred in its plane holds no other vertex
-// (a point of `grid` with vertex[j] set; empty: every point), none even within 1e-8 of its
-// radius (far beyond the rounding of its centre). Two such triangles, among those vertices,
-// never cross: the difference of the powers of a point with respect to their two spheres is an
-// affine function, positive on one triangle's other corners and negative on the other's, so the
-// triangles can meet only where it is zero, in the corners they share. Points no triangle uses
-// play no part, so noise left out of the mesh does not spoil the certificate. Only triangles
-// without it need to be searched for crossings, and on a clean scan they are few.
-bool in_empty_ball(const HashGrid& grid, const Triangle& t, std::span<const std::uint8_t> vertex);
-
 // The ball through a, b and c centred in their plane, its radius padded by 1e-8 of itself and of
 // the centre's coordinates (far beyond the rounding of the centre): a point outside it is
 // outside the exact ball. False for (nearly) collinear corners.
@@ -38,6 +29,25 @@ bool padded_circumball(const Vec3& a, const Vec3& b, const Vec3& c, Ball& out);
 // positions; neither degenerate) intersect other than in corners or an edge they share; exact
 // (common/triangle_intersection.hpp). The same triangle twice never crosses.
 bool triangles_cross(std::span<const Vec3f> points, const Triangle& a, const Triangle& b);
+
+// The crossing pairs among the triangles of a run, and the triangles no search covers.
+struct RunCrossings {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;  // (s, t), s < t, sorted
+  std::vector<std::uint32_t> without_ball;  // no circumball (corners on a line within ~0.006°)
+};
+
+// Every pair of triangles with a circumball that cross (triangles_cross), found by this fact:
+// two triangles, each with the corners it does not share with the other outside the other's
+// padded circumball (padded_circumball), never cross. The difference of a point's powers with
+// respect to the two spheres is an affine function, positive at one triangle's other corners
+// and negative at the other's, so the triangles can meet only where it vanishes, in the
+// corners they share. So a triangle whose ball holds no vertex (a point some triangle uses) is
+// certified, and the others are tested against the triangles on the vertices in their balls;
+// on a clean scan nearly every triangle is certified. Points no triangle uses play no part, so
+// noise left out of the mesh does not spoil a certificate.
+// Inputs: grid (its points are the corners), triangles. Cost: one ball query per triangle, and
+// a second for each uncertified one; the pairs are the same for any thread count.
+RunCrossings find_crossings(const HashGrid& grid, std::span<const Triangle> triangles);
 
 // Triangles filed by the cell of their bounding box's lower corner, in levels of cells each 8
 // times larger than the one before: a triangle is filed in the first level whose cell its box
@@ -58,18 +68,11 @@ class TriangleCells {
 
   // Whether triangle t (not filed here), with its padded circumball (padded_circumball), and
   // the filed triangle `other` each have their corners the other lacks outside the other's
-  // ball: then they cannot cross (the argument of in_empty_ball).
+  // ball: then they cannot cross (the argument of find_crossings).
   bool apart(const Triangle& t, const Ball& ball, std::uint32_t other) const;
 
   // Every pair (s, t), s < t, of non-degenerate triangles that cross (triangles_cross). Sorted.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_pairs() const;
-
-  // The pairs (s, t), s < t, of non-degenerate triangles that cross where s or t is in `focus`
-  // (ascending triangle indices). Sorted, each pair once. A pair whose corners each lie outside
-  // the other's circumball (apart) cannot cross, by the argument of in_empty_ball, and is not
-  // tested further.
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_pairs_involving(
-      std::span<const std::uint32_t> focus) const;
 
  private:
   struct Box {
@@ -94,7 +97,6 @@ class TriangleCells {
            a.lo.z <= b.hi.z && b.lo.z <= a.hi.z;
   }
   void build(Level& level, std::span<const std::uint32_t> members);
-  bool apart(std::uint32_t s, std::uint32_t t) const { return apart(triangles_[s], balls_[s], t); }
   // Calls visit(t) for the triangles of `level` whose lower corner lies in the cells that
   // [lo - cell, hi] covers: every filed triangle whose box can overlap [lo, hi].
   template <class Visit>

@@ -339,17 +339,15 @@ class Grower {
   }
 
   // Of every pair of crossing triangles, the one grown later is marked dead (fronts that met
-  // between the layers of a noisy scan). Triangles loaded before the run are never removed.
-  // Corners of removed triangles become suspects of the non-manifold pass. Only pairs with a
-  // triangle not in an empty ball can cross (detail::in_empty_ball).
+  // between the layers of a noisy scan), and so is every triangle without a circumball (a
+  // sliver no search covers; its hole is filled like any other). Triangles loaded before the
+  // run are never removed. Corners of removed triangles become suspects of the non-manifold
+  // pass.
   std::vector<std::uint8_t> remove_crossings() {
     std::vector<std::uint8_t> dead(triangles_.size(), 0);
-    const std::vector<std::uint32_t> focus = uncertified();
-    if (focus.empty()) return dead;
-    const auto pairs =
-        detail::TriangleCells(grid_.points(), triangles_).crossing_pairs_involving(focus);
-    if (pairs.empty()) return dead;
-    for (const auto& [first, second] : pairs) {
+    const detail::RunCrossings crossings = detail::find_crossings(grid_, triangles_);
+    for (const std::uint32_t t : crossings.without_ball) dead[t] = t >= preloaded_;
+    for (const auto& [first, second] : crossings.pairs) {
       if (dead[first] || dead[second]) continue;
       if (second >= preloaded_) {
         dead[second] = 1;
@@ -362,25 +360,6 @@ class Grower {
         second_fans_.insert(second_fans_.end(), triangles_[t].begin(), triangles_[t].end());
     }
     return dead;
-  }
-
-  // The triangles not certified crossing-free by a ball through their corners empty of the run's
-  // vertices (every point a triangle uses; this runs before any removal), ascending.
-  std::vector<std::uint32_t> uncertified() const {
-    std::vector<std::uint8_t> vertex(grid_.size());
-    for (std::uint32_t v = 0; v < grid_.size(); ++v) vertex[v] = used(v);
-    std::vector<std::uint8_t> empty(triangles_.size(), 0);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, triangles_.size(), 1024),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
-                        for (std::size_t t = range.begin(); t < range.end(); ++t) {
-                          empty[t] = detail::in_empty_ball(grid_, triangles_[t], vertex);
-                        }
-                      });
-    std::vector<std::uint32_t> rest;
-    for (std::uint32_t t = 0; t < triangles_.size(); ++t) {
-      if (!empty[t]) rest.push_back(t);
-    }
-    return rest;
   }
 
   // The triangle as it will face once its group's orientation is applied.
@@ -399,7 +378,10 @@ class Grower {
   // own, and filling it makes the two fans one; a loop through a point twice is split there.
   // Appends the filling triangles to triangles_.
   void fill_holes() {
-    std::optional<detail::TriangleCells> cells;  // of the grown triangles, once a loop needs them
+    // The grown triangles filed for the crossing test, once a loop needs them. The fillings wait
+    // in `filled` until every loop is done, so that the filed triangles stay where they are.
+    std::optional<detail::TriangleCells> cells;
+    std::vector<Triangle> filled;
     std::vector<OpenEdge> open;
     const auto grown = static_cast<std::uint32_t>(triangles_.size());
     for (std::uint32_t t = 0; t < grown; ++t) {
@@ -486,7 +468,7 @@ class Grower {
       const auto chord_ok = [&](std::size_t i, std::size_t j) {
         return edges_.find(loop[i], loop[j]) == EdgeMap::kMissing;
       };
-      if (!cells) cells.emplace(grid_.points(), std::span<const Triangle>(triangles_).first(grown));
+      if (!cells) cells.emplace(grid_.points(), std::span<const Triangle>(triangles_));
       const auto triangle_ok = [&](std::size_t i, std::size_t k, std::size_t j) {
         return fill_fits({loop[i], loop[k], loop[j]}, *cells);
       };
@@ -501,16 +483,17 @@ class Grower {
         groups_.unite(groups_.find(group).first, groups_.find(group_[open[e].triangle]).first, 0);
       }
       const std::uint8_t flip = groups_.find(group).second;
-      const auto first = static_cast<std::uint32_t>(triangles_.size());
+      const auto first = static_cast<std::uint32_t>(grown + filled.size());
       for (const Triangle& t : fill) {
-        const auto id = static_cast<std::uint32_t>(triangles_.size());
-        triangles_.push_back(t);
+        const auto id = static_cast<std::uint32_t>(grown + filled.size());
+        filled.push_back(t);
         group_.push_back(group);
         flip_.push_back(flip);
         fill_loop_.push_back(first);
         for (int k = 0; k < 3; ++k) edges_.add(t[k], t[(k + 1) % 3], id);
       }
     }
+    triangles_.insert(triangles_.end(), filled.begin(), filled.end());
   }
 
   // An open edge u -> v as its triangle (`triangle`) faces.

@@ -1,6 +1,8 @@
-// The grower's search for crossing triangles (src/grow/crossings.hpp): TriangleCells must find
-// exactly the pairs a test of every pair finds, on soups of small and large triangles where
-// many cross, and for_each_near must report every triangle whose box overlaps the query.
+// The grower's search for crossing triangles (src/grow/crossings.hpp): find_crossings and
+// TriangleCells must find exactly the pairs a test of every pair finds, and TriangleCells with
+// the power test exactly the triangles a new one crosses, on soups of small and large triangles
+// where many cross, on every triangle of nearby points in a random cloud, and where four points
+// lie on one circle.
 #include "grow/crossings.hpp"
 
 #include <gtest/gtest.h>
@@ -12,59 +14,140 @@
 namespace g2s {
 namespace {
 
+using Pairs = std::vector<std::pair<std::uint32_t, std::uint32_t>>;
+
+// A grid of the points, and the triangles renumbered to its indices.
 struct Soup {
-  std::vector<Vec3f> points;
+  HashGrid grid;
   std::vector<Triangle> triangles;
 };
+
+Soup soup_of(const std::vector<float>& xyz, std::vector<Triangle> triangles) {
+  Soup soup{HashGrid(xyz, {}), std::move(triangles)};
+  std::vector<Index> at(soup.grid.size());  // grid index of each input point
+  for (Index i = 0; i < soup.grid.size(); ++i) at[soup.grid.source(i)] = i;
+  for (Triangle& t : soup.triangles) {
+    for (Index& v : t) v = at[v];
+  }
+  return soup;
+}
 
 // Triangles with corners near random centres; one in `large_every` is many times larger.
 Soup random_soup(std::size_t count, int large_every, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> where(0, 10), offset(-0.6f, 0.6f);
-  Soup soup;
+  std::vector<float> xyz;
+  std::vector<Triangle> triangles;
   for (std::size_t t = 0; t < count; ++t) {
-    // Most large ones 8 times, one in five of them 60 times: three levels of cells at least.
     const auto every = static_cast<std::size_t>(large_every);
     const float scale =
         large_every > 0 && t % every == 0 ? (t % (5 * every) == 0 ? 60.0f : 8.0f) : 1.0f;
-    const Vec3f c{where(rng), where(rng), where(rng) * 0.1f};
-    const auto first = static_cast<Index>(soup.points.size());
+    const float c[3] = {where(rng), where(rng), where(rng) * 0.1f};
+    const auto first = static_cast<Index>(xyz.size() / 3);
     for (int k = 0; k < 3; ++k) {
-      soup.points.push_back(
-          {c.x + scale * offset(rng), c.y + scale * offset(rng), c.z + scale * offset(rng) * 0.3f});
+      xyz.push_back(c[0] + scale * offset(rng));
+      xyz.push_back(c[1] + scale * offset(rng));
+      xyz.push_back(c[2] + scale * offset(rng) * 0.3f);
     }
     // Every third triangle shares a corner with the one before: shared corners are exercised.
     Triangle tri{first, first + 1, first + 2};
     if (t % 3 == 2) tri[0] = first - 1;
-    soup.triangles.push_back(tri);
+    triangles.push_back(tri);
   }
-  return soup;
+  return soup_of(xyz, std::move(triangles));
 }
 
-TEST(Crossings, CellsFindExactlyThePairsOfABruteForceSearch) {
-  for (const int large_every : {0, 7}) {
-    const Soup soup = random_soup(600, large_every, 11u + static_cast<unsigned>(large_every));
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> expected;
-    for (std::uint32_t s = 0; s < soup.triangles.size(); ++s) {
-      for (std::uint32_t t = s + 1; t < soup.triangles.size(); ++t) {
-        if (detail::triangles_cross(soup.points, soup.triangles[s], soup.triangles[t])) {
-          expected.push_back({s, t});
-        }
+Pairs brute_force_pairs(const Soup& soup) {
+  Pairs pairs;
+  for (std::uint32_t s = 0; s < soup.triangles.size(); ++s) {
+    for (std::uint32_t t = s + 1; t < soup.triangles.size(); ++t) {
+      if (detail::triangles_cross(soup.grid.points(), soup.triangles[s], soup.triangles[t])) {
+        pairs.push_back({s, t});
       }
     }
-    ASSERT_GT(expected.size(), 50u) << "the soup must cross itself to test anything";
-    const detail::TriangleCells cells(soup.points, soup.triangles);
-    EXPECT_EQ(cells.crossing_pairs(), expected);
-    // Focused on some triangles: exactly the pairs that involve one of them.
-    std::vector<std::uint32_t> focus;
-    for (std::uint32_t t = 0; t < soup.triangles.size(); t += 5) focus.push_back(t);
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> involving;
-    for (const auto& [s, t] : expected) {
-      if (s % 5 == 0 || t % 5 == 0) involving.push_back({s, t});
-    }
-    ASSERT_FALSE(involving.empty());
-    EXPECT_EQ(cells.crossing_pairs_involving(focus), involving);
   }
+  return pairs;
+}
+
+// Whether triangle t crosses a filed triangle, as the grower's hole filling asks: the filed
+// triangles whose boxes overlap t's, the power test, then the exact one.
+bool cells_say_crosses(const Soup& soup, const detail::TriangleCells& cells,
+                       std::span<const Triangle> filed, const Triangle& t) {
+  const auto position = [&](int k) { return soup.grid.position(t[k]); };
+  Ball ball;
+  EXPECT_TRUE(detail::padded_circumball(position(0), position(1), position(2), ball));
+  Vec3f lo = soup.grid.point(t[0]), hi = lo;
+  for (const Index v : t) {
+    const Vec3f& p = soup.grid.point(v);
+    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+  }
+  bool crosses = false;
+  cells.for_each_near(lo, hi, [&](std::uint32_t other) {
+    crosses = crosses || (!cells.apart(t, ball, other) &&
+                          detail::triangles_cross(soup.grid.points(), t, filed[other]));
+  });
+  return crosses;
+}
+
+TEST(Crossings, BothSearchesFindExactlyThePairsOfABruteForceSearch) {
+  for (const int large_every : {0, 7}) {
+    const Soup soup = random_soup(600, large_every, 11u + static_cast<unsigned>(large_every));
+    const Pairs expected = brute_force_pairs(soup);
+    ASSERT_GT(expected.size(), 50u) << "the soup must cross itself to test anything";
+    const detail::RunCrossings found = detail::find_crossings(soup.grid, soup.triangles);
+    EXPECT_EQ(found.pairs, expected);
+    EXPECT_TRUE(found.without_ball.empty());
+    EXPECT_EQ(detail::TriangleCells(soup.grid.points(), soup.triangles).crossing_pairs(), expected);
+  }
+}
+
+TEST(Crossings, CellsWithThePowerTestFindEveryTriangleANewOneCrosses) {
+  // Two triangles in three filed; new triangles of their corners (an edge of a filed triangle
+  // with the corner nearest its centre) ask whether they cross one.
+  for (const int large_every : {0, 7}) {
+    const Soup soup = random_soup(600, large_every, 3u + static_cast<unsigned>(large_every));
+    std::vector<Triangle> filed;
+    for (std::size_t t = 0; t < soup.triangles.size(); ++t) {
+      if (t % 3 != 1) filed.push_back(soup.triangles[t]);
+    }
+    const detail::TriangleCells cells(soup.grid.points(), filed);
+    std::size_t crossing = 0, clear = 0;
+    for (const Triangle& from : filed) {
+      const Vec3 centre = (soup.grid.position(from[0]) + soup.grid.position(from[1]) +
+                           soup.grid.position(from[2])) *
+                          (1.0 / 3);
+      Index nearest = kNoIndex;
+      for (const Triangle& other : filed) {
+        for (const Index v : other) {
+          if (std::find(from.begin(), from.end(), v) != from.end()) continue;
+          if (nearest == kNoIndex ||
+              norm2(soup.grid.position(v) - centre) < norm2(soup.grid.position(nearest) - centre)) {
+            nearest = v;
+          }
+        }
+      }
+      const Triangle tri{from[0], from[1], nearest};
+      if (detail::degenerate(soup.grid.points(), tri)) continue;
+      bool expect = false;
+      for (const Triangle& o : filed) {
+        expect = expect || detail::triangles_cross(soup.grid.points(), tri, o);
+      }
+      EXPECT_EQ(cells_say_crosses(soup, cells, filed, tri), expect);
+      crossing += expect;
+      clear += !expect;
+    }
+    EXPECT_GT(crossing, 10u);
+    EXPECT_GT(clear, 10u);
+  }
+}
+
+TEST(Crossings, ASliverWithoutABallIsListedApart) {
+  const std::vector<float> xyz = {0, 0, 0, 1, 0, 0, 2, 1e-6f, 0, 0, 1, 0};
+  const Soup soup = soup_of(xyz, {{0, 1, 3}, {0, 1, 2}});
+  const detail::RunCrossings found = detail::find_crossings(soup.grid, soup.triangles);
+  EXPECT_EQ(found.without_ball, std::vector<std::uint32_t>{1});
+  EXPECT_TRUE(found.pairs.empty());
 }
 
 TEST(Crossings, SharedEdgesAndCornersAreNotCrossings) {
@@ -81,80 +164,47 @@ TEST(Crossings, SharedEdgesAndCornersAreNotCrossings) {
   EXPECT_TRUE(detail::triangles_cross(pierce, {0, 1, 2}, {3, 4, 5}));
 }
 
-TEST(Crossings, TrianglesInEmptyBallsNeverCrossEachOther) {
-  // Every triangle of nearby corners in a random cloud; those certified by an empty ball must
-  // be pairwise free of crossings, while the rest cross plenty.
+TEST(Crossings, EveryCrossingAmongTheTrianglesOfACloudIsFound) {
+  // Every triangle of nearby points in a random cloud: they cross plenty, and each pair an index
+  // of them reports is one a test of every pair finds. Then with one point in four left out
+  // (no triangle uses it, and it must not count against a ball).
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> where(0, 1);
   std::vector<float> xyz;
   for (int i = 0; i < 3 * 120; ++i) xyz.push_back(where(rng));
-  const HashGrid grid(xyz, {});
-  std::vector<Triangle> triangles;
-  for (Index a = 0; a < grid.size(); ++a) {
-    for (Index b = a + 1; b < grid.size(); ++b) {
-      for (Index c = b + 1; c < grid.size(); ++c) {
-        const auto near = [&](Index u, Index v) {
-          return norm2(grid.position(u) - grid.position(v)) < 0.09;
-        };
-        if (near(a, b) && near(b, c) && near(a, c)) triangles.push_back({a, b, c});
+  const auto near = [&](Index u, Index v) {
+    float d2 = 0;
+    for (int k = 0; k < 3; ++k)
+      d2 += (xyz[3 * u + k] - xyz[3 * v + k]) * (xyz[3 * u + k] - xyz[3 * v + k]);
+    return d2 < 0.09f;
+  };
+  for (const Index skip : {Index{0}, Index{4}}) {
+    std::vector<Triangle> triangles;
+    for (Index a = 0; a < 120; ++a) {
+      for (Index b = a + 1; b < 120; ++b) {
+        for (Index c = b + 1; c < 120; ++c) {
+          const bool used = skip == 0 || (a % skip != 0 && b % skip != 0 && c % skip != 0);
+          if (used && near(a, b) && near(b, c) && near(a, c)) triangles.push_back({a, b, c});
+        }
       }
     }
-  }
-  std::size_t crossings = 0;
-  for (std::size_t s = 0; s < triangles.size(); ++s) {
-    for (std::size_t t = s + 1; t < triangles.size(); ++t) {
-      crossings += detail::triangles_cross(grid.points(), triangles[s], triangles[t]);
-    }
-  }
-  EXPECT_GT(crossings, 100u);
-  // Every point a vertex, then one point in four left out (no triangle uses it, and it does
-  // not count against a ball).
-  std::vector<std::uint8_t> three_in_four(grid.size());
-  for (Index v = 0; v < grid.size(); ++v) three_in_four[v] = v % 4 != 0;
-  for (const std::vector<std::uint8_t>& vertex : {std::vector<std::uint8_t>{}, three_in_four}) {
-    std::vector<Triangle> certified;
-    for (const Triangle& t : triangles) {
-      const bool uses_vertices = vertex.empty() || (vertex[t[0]] && vertex[t[1]] && vertex[t[2]]);
-      if (uses_vertices && detail::in_empty_ball(grid, t, vertex)) certified.push_back(t);
-    }
-    ASSERT_GT(certified.size(), 80u);
-    ASSERT_LT(certified.size(), triangles.size() / 2);
-    for (std::size_t s = 0; s < certified.size(); ++s) {
-      for (std::size_t t = s + 1; t < certified.size(); ++t) {
-        EXPECT_FALSE(detail::triangles_cross(grid.points(), certified[s], certified[t]));
-      }
-    }
+    const Soup soup = soup_of(xyz, std::move(triangles));
+    const Pairs expected = brute_force_pairs(soup);
+    EXPECT_GT(expected.size(), 300u);
+    EXPECT_EQ(detail::find_crossings(soup.grid, soup.triangles).pairs, expected);
   }
 }
 
-TEST(Crossings, AFourthPointOnTheSphereDeniesTheCertificate) {
-  // A square's corners lie on one circle: either diagonal's triangles could be Delaunay, and the
-  // two splits overlap, so no triangle of them may be certified. A point nudged off the circle
-  // decides it.
+TEST(Crossings, FourPointsOnOneCircleAreSearched) {
+  // A square's corners lie on one circle: each of its four triangles has the fourth corner on
+  // its ball's sphere, and the two ways to split the square overlap. A point exactly on the
+  // sphere must count as inside, or the overlaps would go unsearched.
   const std::vector<float> square = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
-  const HashGrid on_circle(square, {});
-  for (const Triangle& t : {Triangle{0, 1, 2}, Triangle{0, 2, 3}, Triangle{0, 1, 3}}) {
-    EXPECT_FALSE(detail::in_empty_ball(on_circle, t, {}));
-  }
-  // A fourth point that is no vertex (left out of the mesh) does not count.
-  for (Index left_out = 0; left_out < 4; ++left_out) {
-    std::vector<std::uint8_t> vertex(4, 1);
-    vertex[left_out] = 0;
-    Triangle t;
-    for (Index k = 0, n = 0; k < 4; ++k) {
-      if (k != left_out) t[n++] = k;
-    }
-    EXPECT_TRUE(detail::in_empty_ball(on_circle, t, vertex));
-  }
-  std::vector<float> kite = square;
-  kite[10] = 1.01f;  // the fourth corner just outside the circle of the first three
-  const HashGrid off_circle(kite, {});
-  Index at[4];  // grid index of each input point
-  for (Index i = 0; i < 4; ++i) at[off_circle.source(i)] = i;
-  EXPECT_TRUE(detail::in_empty_ball(off_circle, {at[0], at[1], at[2]}, {}));
-  EXPECT_TRUE(detail::in_empty_ball(off_circle, {at[0], at[2], at[3]}, {}));
-  EXPECT_FALSE(detail::in_empty_ball(off_circle, {at[0], at[1], at[3]}, {}));
-  EXPECT_FALSE(detail::in_empty_ball(off_circle, {at[1], at[2], at[3]}, {}));
+  const std::vector<Triangle> four = {{0, 1, 2}, {0, 2, 3}, {0, 1, 3}, {1, 2, 3}};
+  const Soup soup = soup_of(square, four);
+  const Pairs expected = brute_force_pairs(soup);
+  ASSERT_EQ(expected.size(), 4u);  // each split against each triangle of the other
+  EXPECT_EQ(detail::find_crossings(soup.grid, soup.triangles).pairs, expected);
 }
 
 }  // namespace
