@@ -58,6 +58,14 @@ RunCrossings find_crossings(const HashGrid& grid, std::span<const Triangle> tria
 // object.
 class TriangleCells {
  public:
+  struct Box {
+    Vec3f lo, hi;
+  };
+  static bool overlap(const Box& a, const Box& b) {
+    return a.lo.x <= b.hi.x && b.lo.x <= a.hi.x && a.lo.y <= b.hi.y && b.lo.y <= a.hi.y &&
+           a.lo.z <= b.hi.z && b.lo.z <= a.hi.z;
+  }
+
   TriangleCells(std::span<const Vec3f> points, std::span<const Triangle> triangles);
 
   // Calls visit(t) once for every triangle whose bounding box overlaps the box [lo, hi].
@@ -65,6 +73,7 @@ class TriangleCells {
   void for_each_near(const Vec3f& lo, const Vec3f& hi, Visit&& visit) const;
 
   bool degenerate(std::uint32_t t) const { return degenerate_[t] != 0; }
+  const Box& box(std::uint32_t t) const { return boxes_[t]; }
 
   // Whether triangle t (not filed here), with its padded circumball (padded_circumball), and
   // the filed triangle `other` each have their corners the other lacks outside the other's
@@ -75,9 +84,6 @@ class TriangleCells {
   std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_pairs() const;
 
  private:
-  struct Box {
-    Vec3f lo, hi;
-  };
   // One size of cell: per filed triangle, in cell order; cells in an open-addressing table.
   struct Level {
     double inverse_cell = 1;
@@ -92,10 +98,6 @@ class TriangleCells {
   static constexpr std::uint64_t kEmpty = ~0ull;
   static constexpr std::int64_t kBias = std::int64_t{1} << 20;  // added to cell coordinates
   static std::uint64_t key(std::int64_t x, std::int64_t y, std::int64_t z);
-  static bool overlap(const Box& a, const Box& b) {
-    return a.lo.x <= b.hi.x && b.lo.x <= a.hi.x && a.lo.y <= b.hi.y && b.lo.y <= a.hi.y &&
-           a.lo.z <= b.hi.z && b.lo.z <= a.hi.z;
-  }
   void build(Level& level, std::span<const std::uint32_t> members);
   // Calls visit(t) for the triangles of `level` whose lower corner lies in the cells that
   // [lo - cell, hi] covers: every filed triangle whose box can overlap [lo, hi].

@@ -469,6 +469,19 @@ class Grower {
         return edges_.find(loop[i], loop[j]) == EdgeMap::kMissing;
       };
       if (!cells) cells.emplace(grid_.points(), std::span<const Triangle>(triangles_));
+      // Every filling triangle lies in the loop's box: the grown triangles that may cross one
+      // are those whose boxes overlap it, found once per loop.
+      detail::TriangleCells::Box loop_box{grid_.point(loop[0]), grid_.point(loop[0])};
+      for (const Index v : loop) {
+        const Vec3f& p = grid_.point(v);
+        loop_box.lo = {std::min(loop_box.lo.x, p.x), std::min(loop_box.lo.y, p.y),
+                       std::min(loop_box.lo.z, p.z)};
+        loop_box.hi = {std::max(loop_box.hi.x, p.x), std::max(loop_box.hi.y, p.y),
+                       std::max(loop_box.hi.z, p.z)};
+      }
+      loop_near_.clear();
+      cells->for_each_near(loop_box.lo, loop_box.hi,
+                           [&](std::uint32_t other) { loop_near_.push_back(other); });
       const auto triangle_ok = [&](std::size_t i, std::size_t k, std::size_t j) {
         return fill_fits({loop[i], loop[k], loop[j]}, *cells);
       };
@@ -585,17 +598,16 @@ class Grower {
     return normalized(cross(grid_.position(tri[1]) - a, grid_.position(tri[2]) - a));
   }
 
-  // Whether a triangle filling a hole stays clear of the context points, crosses no live
-  // triangle of the mesh and repeats none (the loop around a lone triangle that touches the rest
-  // at a corner is a loop of its own).
+  // Whether a triangle filling a hole stays clear of the context points, crosses none of the
+  // grown triangles near the loop (loop_near_) and repeats none (the loop around a lone triangle
+  // that touches the rest at a corner is a loop of its own).
   bool fill_fits(const Triangle& t, const detail::TriangleCells& cells) {
     const Vec3f& p0 = grid_.point(t[0]);
     const Vec3f& p1 = grid_.point(t[1]);
     const Vec3f& p2 = grid_.point(t[2]);
-    const Vec3f lo{std::min({p0.x, p1.x, p2.x}), std::min({p0.y, p1.y, p2.y}),
-                   std::min({p0.z, p1.z, p2.z})};
-    const Vec3f hi{std::max({p0.x, p1.x, p2.x}), std::max({p0.y, p1.y, p2.y}),
-                   std::max({p0.z, p1.z, p2.z})};
+    const detail::TriangleCells::Box box{
+        {std::min({p0.x, p1.x, p2.x}), std::min({p0.y, p1.y, p2.y}), std::min({p0.z, p1.z, p2.z})},
+        {std::max({p0.x, p1.x, p2.x}), std::max({p0.y, p1.y, p2.y}), std::max({p0.z, p1.z, p2.z})}};
     // Points this run may not use (a seam's context: tiles still to come) must not lie in
     // the triangle's circumball: the surface may yet be meshed over them. The same (padded)
     // ball settles most neighbours by the power test (TriangleCells::apart).
@@ -611,15 +623,16 @@ class Grower {
       });
       if (covers_context) return false;
     }
-    bool crosses = false;
-    cells.for_each_near(lo, hi, [&](std::uint32_t other) {
-      if (crosses) return;
+    for (const std::uint32_t other : loop_near_) {
+      if (!detail::TriangleCells::overlap(box, cells.box(other))) continue;
       const Triangle& o = triangles_[other];
-      crosses = std::is_permutation(o.begin(), o.end(), t.begin()) ||
-                (!cells.degenerate(other) && !cells.apart(t, ball, other) &&
-                 detail::triangles_cross(grid_.points(), t, o));
-    });
-    return !crosses;
+      if (std::is_permutation(o.begin(), o.end(), t.begin())) return false;
+      if (!cells.degenerate(other) && !cells.apart(t, ball, other) &&
+          detail::triangles_cross(grid_.points(), t, o)) {
+        return false;
+      }
+    }
+    return true;
   }
 
   // Fillings of neighbouring holes may cross each other: the later filling of each crossing
@@ -940,6 +953,7 @@ class Grower {
   std::vector<WalkPoint> cand_;
   std::vector<Index> excluded_;  // points a retried edge has already failed with
   std::vector<std::pair<double, std::uint32_t>> near_;
+  std::vector<std::uint32_t> loop_near_;  // fill_holes: grown triangles near the loop filled
 };
 
 }  // namespace
