@@ -99,8 +99,8 @@ class TriangleCells {
   static constexpr std::int64_t kBias = std::int64_t{1} << 20;  // added to cell coordinates
   static std::uint64_t key(std::int64_t x, std::int64_t y, std::int64_t z);
   void build(Level& level, std::span<const std::uint32_t> members);
-  // Calls visit(t) for the triangles of `level` whose lower corner lies in the cells that
-  // [lo - cell, hi] covers: every filed triangle whose box can overlap [lo, hi].
+  // Calls visit(e) for the places e in level.filed of the triangles whose lower corner lies in
+  // the cells that [lo - cell, hi] covers: every filed triangle whose box can overlap [lo, hi].
   template <class Visit>
   void scan(const Level& level, const Vec3f& lo, const Vec3f& hi, Visit&& visit) const;
 
@@ -125,7 +125,7 @@ void TriangleCells::scan(const Level& level, const Vec3f& lo, const Vec3f& hi,
       for (std::int64_t x = x0; x <= x1; ++x) {
         const std::size_t s = level.find(key(x, y, z));
         if (s == level.keys.size()) continue;
-        for (std::uint32_t e = level.begin[s]; e < level.end[s]; ++e) visit(level.filed[e]);
+        for (std::uint32_t e = level.begin[s]; e < level.end[s]; ++e) visit(e);
       }
     }
   }
@@ -134,11 +134,12 @@ void TriangleCells::scan(const Level& level, const Vec3f& lo, const Vec3f& hi,
 template <class Visit>
 void TriangleCells::for_each_near(const Vec3f& lo, const Vec3f& hi, Visit&& visit) const {
   const Box query{lo, hi};
-  const auto near = [&](std::uint32_t t) {
-    if (overlap(boxes_[t], query)) visit(t);
-  };
   for (const Level& level : levels_) {
-    if (!level.filed.empty()) scan(level, lo, hi, near);
+    if (level.filed.empty()) continue;
+    // The boxes in filing order: a cell's triangles are read from one run of memory.
+    scan(level, lo, hi, [&](std::uint32_t e) {
+      if (overlap(level.boxes[e], query)) visit(level.filed[e]);
+    });
   }
 }
 

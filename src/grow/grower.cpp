@@ -385,6 +385,10 @@ class Grower {
     std::vector<OpenEdge> open;
     const auto grown = static_cast<std::uint32_t>(triangles_.size());
     for (std::uint32_t t = 0; t < grown; ++t) {
+      if (t + 8 < grown) {
+        const Triangle& ahead = triangles_[t + 8];
+        for (int k = 0; k < 3; ++k) edges_.prefetch(ahead[k], ahead[(k + 1) % 3]);
+      }
       const Triangle tri = facing(t);
       for (int k = 0; k < 3; ++k) {
         const Index u = tri[k], v = tri[(k + 1) % 3];
@@ -480,8 +484,9 @@ class Grower {
                        std::max(loop_box.hi.z, p.z)};
       }
       loop_near_.clear();
-      cells->for_each_near(loop_box.lo, loop_box.hi,
-                           [&](std::uint32_t other) { loop_near_.push_back(other); });
+      cells->for_each_near(loop_box.lo, loop_box.hi, [&](std::uint32_t other) {
+        loop_near_.push_back({other, cells->box(other)});
+      });
       const auto triangle_ok = [&](std::size_t i, std::size_t k, std::size_t j) {
         return fill_fits({loop[i], loop[k], loop[j]}, *cells);
       };
@@ -623,8 +628,8 @@ class Grower {
       });
       if (covers_context) return false;
     }
-    for (const std::uint32_t other : loop_near_) {
-      if (!detail::TriangleCells::overlap(box, cells.box(other))) continue;
+    for (const auto& [other, other_box] : loop_near_) {
+      if (!detail::TriangleCells::overlap(box, other_box)) continue;
       const Triangle& o = triangles_[other];
       if (std::is_permutation(o.begin(), o.end(), t.begin())) return false;
       if (!cells.degenerate(other) && !cells.apart(t, ball, other) &&
@@ -953,7 +958,8 @@ class Grower {
   std::vector<WalkPoint> cand_;
   std::vector<Index> excluded_;  // points a retried edge has already failed with
   std::vector<std::pair<double, std::uint32_t>> near_;
-  std::vector<std::uint32_t> loop_near_;  // fill_holes: grown triangles near the loop filled
+  // fill_holes: the grown triangles near the loop being filled, with their boxes
+  std::vector<std::pair<std::uint32_t, detail::TriangleCells::Box>> loop_near_;
 };
 
 }  // namespace
