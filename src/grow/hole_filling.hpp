@@ -34,6 +34,8 @@ struct HoleScratch {
   std::vector<std::uint16_t> by_fold;
   std::vector<std::uint16_t> count;
   std::vector<std::size_t> stack;
+  // Per triangle (i, k, j), i < k < j: 0 not yet asked, 1 allowed, 2 not.
+  std::vector<std::uint8_t> verdict;
 };
 
 inline double triangle_area(const Vec3f& a, const Vec3f& b, const Vec3f& c) {
@@ -54,6 +56,8 @@ inline double triangle_area(const Vec3f& a, const Vec3f& b, const Vec3f& c) {
 // greedily.
 // O(n^4) time at worst, far less as a rule (a parent's search stops at the first apex whose own
 // fold cannot win), O(n^3) scratch: loops are short (the grower's limit is max_hole_edges).
+// Every triangulation has a triangle on each loop edge, so a loop with an edge that no allowed
+// triangle uses is given up first, after O(n^2) questions to triangle_ok instead of O(n^3).
 template <class ChordOk, class TriangleOk>
 std::optional<double> triangulate_loop(std::span<const Vec3f> points, std::span<const Index> loop,
                                        std::span<const Vec3> around, ChordOk&& chord_ok,
@@ -67,6 +71,37 @@ std::optional<double> triangulate_loop(std::span<const Vec3f> points, std::span<
   if (scratch.states.size() < n * n * n) scratch.states.resize(n * n * n);
   if (scratch.by_fold.size() < n * n * n) scratch.by_fold.resize(n * n * n);
   scratch.count.assign(n * n, 0);
+  scratch.verdict.assign(n * n * n, 0);
+  // Whether triangle (i, k, j), i < k < j, may be made: its chords, its area, then triangle_ok
+  // (asked once).
+  const auto is_edge = [&](std::size_t a, std::size_t b) {
+    return b == a + 1 || (a == 0 && b == n - 1);
+  };
+  const auto allowed = [&](std::size_t i, std::size_t k, std::size_t j) {
+    std::uint8_t& verdict = scratch.verdict[(i * n + k) * n + j];
+    if (verdict == 0) {
+      const Vec3 p = Vec3(points[loop[i]]);
+      const bool ok = (is_edge(i, k) || chord_ok(i, k)) && (is_edge(k, j) || chord_ok(k, j)) &&
+                      (is_edge(i, j) || chord_ok(i, j)) &&
+                      norm2(cross(Vec3(points[loop[k]]) - p, Vec3(points[loop[j]]) - p)) > 0 &&
+                      triangle_ok(i, k, j);
+      verdict = ok ? 1 : 2;
+    }
+    return verdict == 1;
+  };
+  // Each loop edge a-b needs a triangle: the ears on it first (most often allowed), then the
+  // rest.
+  for (std::size_t a = 0; a < n; ++a) {
+    const std::size_t b = (a + 1) % n;
+    bool found = false;
+    for (std::size_t step = 1; step + 1 < n && !found; ++step) {
+      // Apexes by distance along the loop: after b, then before a, alternately.
+      const std::size_t c = step % 2 == 1 ? (b + (step + 1) / 2) % n : (a + n - step / 2) % n;
+      const std::size_t lo = std::min({a, b, c}), hi = std::max({a, b, c});
+      found = allowed(lo, a + b + c - lo - hi, hi);
+    }
+    if (!found) return std::nullopt;
+  }
   const auto state = [&](std::size_t i, std::size_t j, std::size_t k) -> State& {
     return scratch.states[(i * n + j) * n + k];
   };
@@ -106,7 +141,7 @@ std::optional<double> triangulate_loop(std::span<const Vec3f> points, std::span<
         if (!(twice_area > 0)) continue;
         const Vec3 normal = w * (1 / twice_area);
         const Side left = side(i, k, normal), right = side(k, j, normal);
-        if (left.fold_cos == kNone || right.fold_cos == kNone || !triangle_ok(i, k, j)) continue;
+        if (left.fold_cos == kNone || right.fold_cos == kNone || !allowed(i, k, j)) continue;
         state(i, j, k) =
             State{std::min(left.fold_cos, right.fold_cos),
                   left.area + right.area + 0.5 * twice_area, normal, left.apex, right.apex};

@@ -121,6 +121,39 @@ TEST(HoleFilling, CollinearLoopStaysOpen) {
       scratch, out));
 }
 
+TEST(HoleFilling, LoopWithAnEdgeNoTriangleMayUseIsGivenUpEarly) {
+  // Every triangle on the loop edge 5-6 is forbidden: no triangulation exists, and that is
+  // found by asking about the triangles on that edge (and a few ears), not about all of them.
+  constexpr int n = 24;
+  const std::vector<Vec3f> points = regular_polygon(n);
+  const std::vector<Index> loop = identity_loop(n);
+  std::size_t asked = 0;
+  const auto not_on_5_6 = [&](std::size_t i, std::size_t k, std::size_t j) {
+    ++asked;
+    return !((i == 5 && k == 6) || (k == 5 && j == 6));
+  };
+  detail::HoleScratch scratch;
+  std::vector<Triangle> out;
+  EXPECT_FALSE(detail::triangulate_loop(
+      points, loop, flat_around(loop.size()), [](std::size_t, std::size_t) { return true; },
+      not_on_5_6, scratch, out));
+  EXPECT_TRUE(out.empty());
+  EXPECT_LE(asked, static_cast<std::size_t>(2 * n));
+  // Each triangle is asked about once, however often the programme needs it.
+  asked = 0;
+  std::size_t distinct = 0;
+  std::vector<std::uint8_t> seen(n * n * n, 0);
+  const auto counting = [&](std::size_t i, std::size_t k, std::size_t j) {
+    ++asked;
+    distinct += !seen[(i * n + k) * n + j]++;
+    return true;
+  };
+  ASSERT_TRUE(detail::triangulate_loop(
+      points, loop, flat_around(loop.size()), [](std::size_t, std::size_t) { return true; },
+      counting, scratch, out));
+  EXPECT_EQ(asked, distinct);
+}
+
 // Every triangulation of loop positions [i, j] closed by chord i-j, as lists of triangles.
 void all_triangulations(std::size_t i, std::size_t j, std::vector<std::vector<Triangle>>& out) {
   out.clear();
