@@ -210,7 +210,7 @@ Pairs TriangleCells::crossing_pairs() const {
   // Triangles of the larger levels against everything near them (each pair of two such once).
   Pairs& pairs = found.local();
   const auto against_all = [&](std::uint32_t t) {
-    for_each_near(boxes_[t].lo, boxes_[t].hi, [&](std::uint32_t other) {
+    for_each_near(boxes_[t].lo, boxes_[t].hi, [&](std::uint32_t other, const Box&) {
       if (other == t || (level_[other] != 0 && other < t)) return;
       if (degenerate_[t] || degenerate_[other]) return;
       if (triangles_cross(points_, triangles_[t], triangles_[other])) {

@@ -68,12 +68,12 @@ class TriangleCells {
 
   TriangleCells(std::span<const Vec3f> points, std::span<const Triangle> triangles);
 
-  // Calls visit(t) once for every triangle whose bounding box overlaps the box [lo, hi].
+  // Calls visit(t, box of t) once for every triangle whose bounding box overlaps the box
+  // [lo, hi].
   template <class Visit>
   void for_each_near(const Vec3f& lo, const Vec3f& hi, Visit&& visit) const;
 
   bool degenerate(std::uint32_t t) const { return degenerate_[t] != 0; }
-  const Box& box(std::uint32_t t) const { return boxes_[t]; }
 
   // Whether triangle t (not filed here), with its padded circumball (padded_circumball), and
   // the filed triangle `other` each have their corners the other lacks outside the other's
@@ -138,7 +138,7 @@ void TriangleCells::for_each_near(const Vec3f& lo, const Vec3f& hi, Visit&& visi
     if (level.filed.empty()) continue;
     // The boxes in filing order: a cell's triangles are read from one run of memory.
     scan(level, lo, hi, [&](std::uint32_t e) {
-      if (overlap(level.boxes[e], query)) visit(level.filed[e]);
+      if (overlap(level.boxes[e], query)) visit(level.filed[e], level.boxes[e]);
     });
   }
 }

@@ -484,9 +484,10 @@ class Grower {
                        std::max(loop_box.hi.z, p.z)};
       }
       loop_near_.clear();
-      cells->for_each_near(loop_box.lo, loop_box.hi, [&](std::uint32_t other) {
-        loop_near_.push_back({other, cells->box(other)});
-      });
+      cells->for_each_near(loop_box.lo, loop_box.hi,
+                           [&](std::uint32_t other, const detail::TriangleCells::Box& box) {
+                             loop_near_.push_back({other, box});
+                           });
       const auto triangle_ok = [&](std::size_t i, std::size_t k, std::size_t j) {
         return fill_fits({loop[i], loop[k], loop[j]}, *cells);
       };

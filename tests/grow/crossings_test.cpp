@@ -83,7 +83,7 @@ bool cells_say_crosses(const Soup& soup, const detail::TriangleCells& cells,
     hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
   }
   bool crosses = false;
-  cells.for_each_near(lo, hi, [&](std::uint32_t other) {
+  cells.for_each_near(lo, hi, [&](std::uint32_t other, const detail::TriangleCells::Box&) {
     crosses = crosses || (!cells.apart(t, ball, other) &&
                           detail::triangles_cross(soup.grid.points(), t, filed[other]));
   });
