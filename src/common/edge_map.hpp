@@ -88,6 +88,50 @@ class EdgeMap {
     }
   }
 
+  // Takes one triangle off edge {u, v}, which must be in the map: a closed edge becomes open,
+  // still naming the triangle it named (which may be the one taken off: after removals only
+  // whether an edge has none, one or two triangles is known); an open edge leaves the map.
+  void remove(Index u, Index v) {
+    const Index lo = std::min(u, v), hi = std::max(u, v);
+    if (lo < lines_.size()) {
+      Line& line = lines_[lo];
+      for (std::uint32_t k = 0; k < line.count; ++k) {
+        if (line.other[k] != hi) continue;
+        if (line.value[k] & kClosed) {
+          line.value[k] &= ~kClosed;
+        } else {
+          // A gap, not a shift: a full line stays full, so find() still goes on to the spill.
+          line.other[k] = kGap;
+          --size_;
+        }
+        return;
+      }
+    }
+    const std::uint64_t key = std::uint64_t{lo} << 32 | hi;
+    std::size_t s = spill_slot(key);
+    while (spill_keys_[s] != key) s = (s + 1) & (spill_keys_.size() - 1);
+    if (spill_values_[s] & kClosed) {
+      spill_values_[s] &= ~kClosed;
+      return;
+    }
+    // Backward-shift deletion: each later entry of the run moves into the gap unless its home
+    // slot lies cyclically after the gap, so every probe run stays unbroken.
+    const std::size_t mask = spill_keys_.size() - 1;
+    std::size_t gap = s;
+    for (std::size_t j = (s + 1) & mask; spill_keys_[j] != kEmpty; j = (j + 1) & mask) {
+      const std::size_t home = spill_slot(spill_keys_[j]);
+      if (((j - home) & mask) >= ((j - gap) & mask)) {
+        spill_keys_[gap] = spill_keys_[j];
+        spill_values_[gap] = spill_values_[j];
+        gap = j;
+      }
+    }
+    spill_keys_[gap] = kEmpty;
+    spill_values_[gap] = kMissing;
+    --spill_size_;
+    --size_;
+  }
+
   std::size_t size() const { return size_; }
   std::size_t memory_bytes() const {
     return lines_.size() * sizeof(Line) + spill_keys_.size() * 12;
@@ -96,6 +140,7 @@ class EdgeMap {
  private:
   static constexpr std::uint64_t kEmpty = ~0ull;
   static constexpr std::uint32_t kInline = 7;
+  static constexpr Index kGap = 0xFFFFFFFFu;  // a removed edge's place in its line (no vertex)
   // A vertex's edges to larger vertices: 60 bytes, one cache line. A surface has about 3 such
   // edges per vertex, so few spill.
   struct alignas(64) Line {

@@ -308,25 +308,25 @@ class Grower {
     fill_small_holes();
   }
 
-  // Removes the triangles marked dead (never one loaded before the run) and rebuilds the
-  // Point-Edge Map.
+  // Removes the triangles marked dead (never one loaded before the run), and their edges from
+  // the Point-Edge Map. After growth the map is only asked whether an edge has none, one or two
+  // triangles, so the triangle numbers it holds are left as they were.
   void compact(std::vector<std::uint8_t> dead) {
     std::size_t kept = 0;
     for (std::size_t t = 0; t < triangles_.size(); ++t) {
-      if (dead[t] && t >= preloaded_) continue;
+      if (dead[t] && t >= preloaded_) {
+        const Triangle& tri = triangles_[t];
+        for (int k = 0; k < 3; ++k) edges_.remove(tri[k], tri[(k + 1) % 3]);
+        continue;
+      }
       triangles_[kept] = triangles_[t];
       group_[kept] = group_[t];
       flip_[kept] = flip_[t];
       ++kept;
     }
-    if (kept == triangles_.size()) return;
     triangles_.resize(kept);
     group_.resize(kept);
     flip_.resize(kept);
-    edges_.reset(grid_.size());
-    for (std::uint32_t t = 0; t < kept; ++t) {
-      for (int k = 0; k < 3; ++k) edges_.add(triangles_[t][k], triangles_[t][(k + 1) % 3], t);
-    }
   }
 
   // One round of hole filling (fill_holes) and the removal of fillings that cross each other.

@@ -279,6 +279,39 @@ TEST(EdgeMap, SecondTriangleClosesTheEdgeAndKeepsTheFirst) {
   EXPECT_EQ(map.size(), 2u);
 }
 
+TEST(EdgeMap, RemovalsMatchStdMap) {
+  // Vertices with many edges (so that lines fill and spill), triangles added and taken off at
+  // random: after every step the map agrees with a count of triangles per edge.
+  EdgeMap map(50);
+  std::map<std::pair<Index, Index>, int> model;  // triangles on the edge
+  std::mt19937_64 rng(7);
+  for (int step = 0; step < 200000; ++step) {
+    const auto u = static_cast<Index>(rng() % 60), v = static_cast<Index>(rng() % 60);
+    if (u == v) continue;
+    const std::pair<Index, Index> key{std::min(u, v), std::max(u, v)};
+    int& count = model[key];
+    if (count > 0 && (count == 2 || rng() % 2)) {
+      map.remove(v, u);
+      --count;
+    } else {
+      map.add(u, v, static_cast<std::uint32_t>(step));
+      ++count;
+    }
+    if (step % 997 == 0 || step > 199000) {
+      std::size_t present = 0;
+      for (const auto& [edge, triangles] : model) {
+        const std::uint32_t value = map.find(edge.first, edge.second);
+        ASSERT_EQ(value == EdgeMap::kMissing, triangles == 0) << step;
+        if (triangles > 0) {
+          ASSERT_EQ((value & EdgeMap::kClosed) != 0, triangles == 2) << step;
+        }
+        present += triangles > 0;
+      }
+      ASSERT_EQ(map.size(), present);
+    }
+  }
+}
+
 TEST(EdgeMap, ExtremeVertexIndicesAreDistinctEdges) {
   EdgeMap map(4);
   const Index big = g2s::kNoIndex - 1;
