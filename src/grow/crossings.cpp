@@ -171,6 +171,13 @@ RunCrossings find_crossings(const HashGrid& grid, std::span<const Triangle> tria
 }
 
 Pairs TriangleCells::crossing_pairs() const {
+  std::vector<std::uint8_t> collinear(triangles_.size());  // degenerate triangles cross none
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, triangles_.size(), 4096),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t t = range.begin(); t < range.end(); ++t) {
+                        collinear[t] = degenerate(points_, triangles_[t]);
+                      }
+                    });
   const Level& first = levels_[0];
   tbb::enumerable_thread_specific<Pairs> found;
   // The first level: each cell against itself and its 13 neighbours on the forward side, so
@@ -180,7 +187,7 @@ Pairs TriangleCells::crossing_pairs() const {
     const auto test = [&](std::uint32_t i, std::uint32_t j) {
       if (!overlap(first.boxes[i], first.boxes[j])) return;
       const std::uint32_t s = first.filed[i], t = first.filed[j];
-      if (degenerate_[s] || degenerate_[t]) return;
+      if (collinear[s] || collinear[t]) return;
       if (triangles_cross(points_, triangles_[s], triangles_[t])) {
         pairs.push_back({std::min(s, t), std::max(s, t)});
       }
@@ -212,7 +219,7 @@ Pairs TriangleCells::crossing_pairs() const {
   const auto against_all = [&](std::uint32_t t) {
     for_each_near(boxes_[t].lo, boxes_[t].hi, [&](std::uint32_t other, const Box&) {
       if (other == t || (level_[other] != 0 && other < t)) return;
-      if (degenerate_[t] || degenerate_[other]) return;
+      if (collinear[t] || collinear[other]) return;
       if (triangles_cross(points_, triangles_[t], triangles_[other])) {
         pairs.push_back({std::min(t, other), std::max(t, other)});
       }
@@ -224,18 +231,17 @@ Pairs TriangleCells::crossing_pairs() const {
   return sorted_union(found);
 }
 
-bool TriangleCells::apart(const Triangle& t, const Ball& ball, std::uint32_t other) const {
-  const Ball& other_ball = balls_[other];
-  if (ball.radius2 < 0 || other_ball.radius2 < 0) return false;
-  const Triangle& o = triangles_[other];
+bool apart(std::span<const Vec3f> points, const Triangle& a, const Ball& a_ball, const Triangle& b,
+           const Ball& b_ball) {
+  if (a_ball.radius2 < 0 || b_ball.radius2 < 0) return false;
   const auto outside = [&](const Triangle& own, const Triangle& rest, const Ball& around) {
     for (const Index v : own) {
       if (std::find(rest.begin(), rest.end(), v) != rest.end()) continue;
-      if (!(norm2(Vec3(points_[v]) - around.centre) > around.radius2)) return false;
+      if (!(norm2(Vec3(points[v]) - around.centre) > around.radius2)) return false;
     }
     return true;
   };
-  return outside(t, o, other_ball) && outside(o, t, ball);
+  return outside(a, b, b_ball) && outside(b, a, a_ball);
 }
 
 std::int64_t TriangleCells::Level::coord(float v) const {
@@ -292,9 +298,7 @@ TriangleCells::TriangleCells(std::span<const Vec3f> points, std::span<const Tria
     : points_(points),
       triangles_(triangles),
       boxes_(triangles.size()),
-      level_(triangles.size(), 0),
-      degenerate_(triangles.size(), 0),
-      balls_(triangles.size()) {
+      level_(triangles.size(), 0) {
   std::vector<float> extents(triangles.size());
   for (std::uint32_t t = 0; t < triangles.size(); ++t) {
     const Triangle& tri = triangles[t];
@@ -305,8 +309,6 @@ TriangleCells::TriangleCells(std::span<const Vec3f> points, std::span<const Tria
     box.hi = {std::max({p0.x, p1.x, p2.x}), std::max({p0.y, p1.y, p2.y}),
               std::max({p0.z, p1.z, p2.z})};
     extents[t] = std::max({box.hi.x - box.lo.x, box.hi.y - box.lo.y, box.hi.z - box.lo.z});
-    degenerate_[t] = detail::degenerate(points, tri);
-    if (!padded_circumball(Vec3(p0), Vec3(p1), Vec3(p2), balls_[t])) balls_[t].radius2 = -1;
   }
   // The first level's cell holds nine triangles in ten whole; the rest are few enough to be
   // looked up from their own, larger cells.

@@ -49,6 +49,12 @@ struct RunCrossings {
 // a second for each uncertified one; the pairs are the same for any thread count.
 RunCrossings find_crossings(const HashGrid& grid, std::span<const Triangle> triangles);
 
+// Whether triangles a and b, with their padded circumballs (padded_circumball; radius2 < 0 for
+// none), each have the corners the other lacks outside the other's ball: then they cannot cross
+// (the argument of find_crossings). False when either has no ball.
+bool apart(std::span<const Vec3f> points, const Triangle& a, const Ball& a_ball, const Triangle& b,
+           const Ball& b_ball);
+
 // Triangles filed by the cell of their bounding box's lower corner, in levels of cells each 8
 // times larger than the one before: a triangle is filed in the first level whose cell its box
 // fits (the first level holds nine in ten). Two triangles whose boxes overlap are then filed in the
@@ -72,13 +78,6 @@ class TriangleCells {
   // [lo, hi].
   template <class Visit>
   void for_each_near(const Vec3f& lo, const Vec3f& hi, Visit&& visit) const;
-
-  bool degenerate(std::uint32_t t) const { return degenerate_[t] != 0; }
-
-  // Whether triangle t (not filed here), with its padded circumball (padded_circumball), and
-  // the filed triangle `other` each have their corners the other lacks outside the other's
-  // ball: then they cannot cross (the argument of find_crossings).
-  bool apart(const Triangle& t, const Ball& ball, std::uint32_t other) const;
 
   // Every pair (s, t), s < t, of non-degenerate triangles that cross (triangles_cross). Sorted.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_pairs() const;
@@ -108,8 +107,6 @@ class TriangleCells {
   std::span<const Triangle> triangles_;
   std::vector<Box> boxes_;
   std::vector<std::uint8_t> level_;  // per triangle: the level it is filed in
-  std::vector<std::uint8_t> degenerate_;
-  std::vector<Ball> balls_;  // padded circumballs; radius2 < 0: none (nearly collinear)
   std::vector<Level> levels_;
 };
 

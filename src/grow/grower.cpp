@@ -484,12 +484,20 @@ class Grower {
                        std::max(loop_box.hi.z, p.z)};
       }
       loop_near_.clear();
-      cells->for_each_near(loop_box.lo, loop_box.hi,
-                           [&](std::uint32_t other, const detail::TriangleCells::Box& box) {
-                             loop_near_.push_back({other, box});
-                           });
+      cells->for_each_near(
+          loop_box.lo, loop_box.hi,
+          [&](std::uint32_t other, const detail::TriangleCells::Box& box) {
+            const Triangle& o = triangles_[other];
+            NearTriangle near{other, box, {}};
+            if (!detail::padded_circumball(grid_.position(o[0]), grid_.position(o[1]),
+                                           grid_.position(o[2]), near.ball)) {
+              if (detail::degenerate(grid_.points(), o)) return;  // crosses none
+              near.ball.radius2 = -1;
+            }
+            loop_near_.push_back(near);
+          });
       const auto triangle_ok = [&](std::size_t i, std::size_t k, std::size_t j) {
-        return fill_fits({loop[i], loop[k], loop[j]}, *cells);
+        return fill_fits({loop[i], loop[k], loop[j]});
       };
       if (!detail::triangulate_loop(grid_.points(), loop, around, chord_ok, triangle_ok, scratch,
                                     fill)) {
@@ -607,7 +615,7 @@ class Grower {
   // Whether a triangle filling a hole stays clear of the context points, crosses none of the
   // grown triangles near the loop (loop_near_) and repeats none (the loop around a lone triangle
   // that touches the rest at a corner is a loop of its own).
-  bool fill_fits(const Triangle& t, const detail::TriangleCells& cells) {
+  bool fill_fits(const Triangle& t) {
     const Vec3f& p0 = grid_.point(t[0]);
     const Vec3f& p1 = grid_.point(t[1]);
     const Vec3f& p2 = grid_.point(t[2]);
@@ -629,11 +637,11 @@ class Grower {
       });
       if (covers_context) return false;
     }
-    for (const auto& [other, other_box] : loop_near_) {
-      if (!detail::TriangleCells::overlap(box, other_box)) continue;
-      const Triangle& o = triangles_[other];
+    for (const NearTriangle& near : loop_near_) {
+      if (!detail::TriangleCells::overlap(box, near.box)) continue;
+      const Triangle& o = triangles_[near.index];
       if (std::is_permutation(o.begin(), o.end(), t.begin())) return false;
-      if (!cells.degenerate(other) && !cells.apart(t, ball, other) &&
+      if (!detail::apart(grid_.points(), t, ball, o, near.ball) &&
           detail::triangles_cross(grid_.points(), t, o)) {
         return false;
       }
@@ -959,8 +967,14 @@ class Grower {
   std::vector<WalkPoint> cand_;
   std::vector<Index> excluded_;  // points a retried edge has already failed with
   std::vector<std::pair<double, std::uint32_t>> near_;
-  // fill_holes: the grown triangles near the loop being filled, with their boxes
-  std::vector<std::pair<std::uint32_t, detail::TriangleCells::Box>> loop_near_;
+  // fill_holes: the grown triangles near the loop being filled (none degenerate), with their
+  // boxes and padded circumballs (radius2 < 0: none)
+  struct NearTriangle {
+    std::uint32_t index;
+    detail::TriangleCells::Box box;
+    Ball ball;
+  };
+  std::vector<NearTriangle> loop_near_;
 };
 
 }  // namespace

@@ -84,8 +84,12 @@ bool cells_say_crosses(const Soup& soup, const detail::TriangleCells& cells,
   }
   bool crosses = false;
   cells.for_each_near(lo, hi, [&](std::uint32_t other, const detail::TriangleCells::Box&) {
-    crosses = crosses || (!cells.apart(t, ball, other) &&
-                          detail::triangles_cross(soup.grid.points(), t, filed[other]));
+    const Triangle& o = filed[other];
+    Ball other_ball;
+    EXPECT_TRUE(detail::padded_circumball(soup.grid.position(o[0]), soup.grid.position(o[1]),
+                                          soup.grid.position(o[2]), other_ball));
+    crosses = crosses || (!detail::apart(soup.grid.points(), t, ball, o, other_ball) &&
+                          detail::triangles_cross(soup.grid.points(), t, o));
   });
   return crosses;
 }
