@@ -54,47 +54,74 @@ Pairs sorted_union(tbb::enumerable_thread_specific<Pairs>& found) {
 
 RunCrossings find_crossings(const HashGrid& grid, std::span<const Triangle> triangles) {
   const std::size_t n = grid.size();
-  // Per vertex, the triangles on it: the corners sorted by vertex (counting sort).
-  std::vector<std::uint32_t> star_begin(n + 1, 0), star(3 * triangles.size());
+  std::vector<std::uint8_t> vertex(n, 0);  // used by some triangle
   for (const Triangle& t : triangles) {
-    for (const Index v : t) ++star_begin[v + 1];
+    for (const Index v : t) vertex[v] = 1;
   }
-  for (std::size_t v = 0; v < n; ++v) star_begin[v + 1] += star_begin[v];
-  {
-    std::vector<std::uint32_t> at(star_begin.begin(), star_begin.end() - 1);
-    for (std::uint32_t t = 0; t < triangles.size(); ++t) {
-      for (const Index v : triangles[t]) star[at[v]++] = t;
-    }
-  }
-  const auto is_vertex = [&](Index v) { return star_begin[v] != star_begin[v + 1]; };
   const auto ball_of = [&](const Triangle& t, Ball& ball) {
     return padded_circumball(grid.position(t[0]), grid.position(t[1]), grid.position(t[2]), ball);
   };
-  // Whether each triangle has a ball, and whether it holds a vertex (uncertified).
-  enum : std::uint8_t { kNoBall, kCertified, kUncertified };
-  std::vector<std::uint8_t> kind(triangles.size());
+  // The vertices in each triangle's ball (its corners aside): none certifies it. The lists of
+  // the uncertified ones are kept, as runs in their thread's array.
+  struct Run {
+    std::uint32_t triangle, begin, end;
+  };
+  struct Inside {
+    std::vector<Index> vertices;
+    std::vector<Run> runs;
+  };
+  tbb::enumerable_thread_specific<Inside> inside;
+  std::vector<std::uint8_t> has_ball(triangles.size(), 0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, triangles.size(), 1024),
                     [&](const tbb::blocked_range<std::size_t>& range) {
+                      Inside& local = inside.local();
                       for (std::size_t t = range.begin(); t < range.end(); ++t) {
                         const Triangle& tri = triangles[t];
                         Ball ball;
-                        if (!ball_of(tri, ball)) {
-                          kind[t] = kNoBall;
-                          continue;
-                        }
-                        bool empty = true;
+                        if (!ball_of(tri, ball)) continue;
+                        has_ball[t] = 1;
+                        const auto begin = static_cast<std::uint32_t>(local.vertices.size());
                         grid.for_each_in_ball(
                             ball.centre, std::sqrt(ball.radius2), [&](std::uint32_t j, double) {
-                              if (j != tri[0] && j != tri[1] && j != tri[2] && is_vertex(j)) {
-                                empty = false;
+                              if (j != tri[0] && j != tri[1] && j != tri[2] && vertex[j]) {
+                                local.vertices.push_back(j);
                               }
                             });
-                        kind[t] = empty ? kCertified : kUncertified;
+                        const auto end = static_cast<std::uint32_t>(local.vertices.size());
+                        if (end > begin)
+                          local.runs.push_back({static_cast<std::uint32_t>(t), begin, end});
                       }
                     });
   RunCrossings result;
   for (std::uint32_t t = 0; t < triangles.size(); ++t) {
-    if (kind[t] == kNoBall) result.without_ball.push_back(t);
+    if (!has_ball[t]) result.without_ball.push_back(t);
+  }
+  std::vector<std::pair<const Inside*, Run>> uncertified;
+  for (const Inside& part : inside) {
+    for (const Run& run : part.runs) uncertified.push_back({&part, run});
+  }
+  if (uncertified.empty()) return result;
+  std::vector<std::uint8_t> uncertified_triangle(triangles.size(), 0);
+  for (const auto& [part, run] : uncertified) uncertified_triangle[run.triangle] = 1;
+  // The stars of the vertices in some uncertified ball: per such vertex, the triangles on it
+  // (counting sort, in triangle order).
+  std::vector<std::uint8_t> needed(n, 0);
+  for (const Inside& part : inside) {
+    for (const Index v : part.vertices) needed[v] = 1;
+  }
+  std::vector<std::uint32_t> star_begin(n + 1, 0);
+  for (const Triangle& t : triangles) {
+    for (const Index v : t) star_begin[v + 1] += needed[v];
+  }
+  for (std::size_t v = 0; v < n; ++v) star_begin[v + 1] += star_begin[v];
+  std::vector<std::uint32_t> star(star_begin[n]);
+  {
+    std::vector<std::uint32_t> at(star_begin.begin(), star_begin.end() - 1);
+    for (std::uint32_t t = 0; t < triangles.size(); ++t) {
+      for (const Index v : triangles[t]) {
+        if (needed[v]) star[at[v]++] = t;
+      }
+    }
   }
   // Each uncertified triangle against the triangles on the vertices in its ball. A pair where
   // each ball holds a corner of the other is met from both sides; the larger index leaves it
@@ -115,57 +142,45 @@ RunCrossings find_crossings(const HashGrid& grid, std::span<const Triangle> tria
     }
     return false;
   };
-  struct Scratch {
-    std::vector<Index> inside;
-    std::vector<std::uint32_t> near;
-  };
   tbb::enumerable_thread_specific<Pairs> found;
-  tbb::enumerable_thread_specific<Scratch> scratch;
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, triangles.size(), 1024),
-      [&](const tbb::blocked_range<std::size_t>& range) {
-        Pairs& pairs = found.local();
-        Scratch& local = scratch.local();
-        for (std::size_t t = range.begin(); t < range.end(); ++t) {
-          if (kind[t] != kUncertified) continue;
-          const auto id = static_cast<std::uint32_t>(t);
-          const Triangle& tri = triangles[t];
-          Ball ball;
-          ball_of(tri, ball);
-          local.inside.clear();
-          grid.for_each_in_ball(ball.centre, std::sqrt(ball.radius2), [&](std::uint32_t j, double) {
-            if (j != tri[0] && j != tri[1] && j != tri[2] && is_vertex(j)) {
-              local.inside.push_back(j);
-            }
-          });
-          const auto box = box_of(tri);
-          local.near.clear();
-          for (const Index v : local.inside) {
-            for (std::uint32_t s = star_begin[v]; s < star_begin[v + 1]; ++s) {
-              const std::uint32_t other = star[s];
-              if (other == id || kind[other] == kNoBall) continue;
-              const auto other_box = box_of(triangles[other]);
-              if (other_box[0].x > box[1].x || box[0].x > other_box[1].x ||
-                  other_box[0].y > box[1].y || box[0].y > other_box[1].y ||
-                  other_box[0].z > box[1].z || box[0].z > other_box[1].z) {
-                continue;
-              }
-              local.near.push_back(other);
-            }
-          }
-          std::sort(local.near.begin(), local.near.end());
-          local.near.erase(std::unique(local.near.begin(), local.near.end()), local.near.end());
-          for (const std::uint32_t other : local.near) {
-            if (other < id && kind[other] == kUncertified &&
-                holds_corner_of(triangles[other], tri)) {
-              continue;
-            }
-            if (triangles_cross(grid.points(), tri, triangles[other])) {
-              pairs.push_back({std::min(id, other), std::max(id, other)});
-            }
-          }
-        }
-      });
+  tbb::enumerable_thread_specific<std::vector<std::uint32_t>> scratch;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, uncertified.size(), 256),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      Pairs& pairs = found.local();
+                      std::vector<std::uint32_t>& near = scratch.local();
+                      for (std::size_t u = range.begin(); u < range.end(); ++u) {
+                        const auto& [part, run] = uncertified[u];
+                        const std::uint32_t id = run.triangle;
+                        const Triangle& tri = triangles[id];
+                        const auto box = box_of(tri);
+                        near.clear();
+                        for (std::uint32_t k = run.begin; k < run.end; ++k) {
+                          const Index v = part->vertices[k];
+                          for (std::uint32_t s = star_begin[v]; s < star_begin[v + 1]; ++s) {
+                            const std::uint32_t other = star[s];
+                            if (other == id || !has_ball[other]) continue;
+                            const auto other_box = box_of(triangles[other]);
+                            if (other_box[0].x > box[1].x || box[0].x > other_box[1].x ||
+                                other_box[0].y > box[1].y || box[0].y > other_box[1].y ||
+                                other_box[0].z > box[1].z || box[0].z > other_box[1].z) {
+                              continue;
+                            }
+                            near.push_back(other);
+                          }
+                        }
+                        std::sort(near.begin(), near.end());
+                        near.erase(std::unique(near.begin(), near.end()), near.end());
+                        for (const std::uint32_t other : near) {
+                          if (other < id && uncertified_triangle[other] &&
+                              holds_corner_of(triangles[other], tri)) {
+                            continue;
+                          }
+                          if (triangles_cross(grid.points(), tri, triangles[other])) {
+                            pairs.push_back({std::min(id, other), std::max(id, other)});
+                          }
+                        }
+                      }
+                    });
   result.pairs = sorted_union(found);
   return result;
 }
