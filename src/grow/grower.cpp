@@ -389,6 +389,13 @@ class Grower {
         const Triangle& ahead = triangles_[t + 8];
         for (int k = 0; k < 3; ++k) edges_.prefetch(ahead[k], ahead[(k + 1) % 3]);
       }
+      const Triangle& own = triangles_[t];
+      bool open_edge[3];
+      for (int k = 0; k < 3; ++k) {
+        open_edge[k] = !(edges_.find(own[k], own[(k + 1) % 3]) & EdgeMap::kClosed);
+      }
+      if (!open_edge[0] && !open_edge[1] && !open_edge[2]) continue;
+      // Which way the triangle faces is looked up only for the few on a hole.
       const Triangle tri = facing(t);
       for (int k = 0; k < 3; ++k) {
         const Index u = tri[k], v = tri[(k + 1) % 3];
