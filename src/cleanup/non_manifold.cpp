@@ -12,6 +12,93 @@
 #include "common/union_find.hpp"
 
 namespace g2s {
+namespace {
+
+// A triangle seen from one corner: its index and its two other corners, in its order.
+struct Corner {
+  std::uint32_t triangle;
+  Index u, w;
+};
+
+// Per vertex, its triangles in index order, built only for the vertices examined: a batch of
+// vertices (with every corner of their triangles, since a deletion queues those) per pass over
+// the triangles, so that a cleanup near a few suspects does not pay for every vertex's star.
+// After kBatches batches the rest are built at once.
+class Stars {
+ public:
+  Stars(std::span<const Triangle> triangles, std::size_t vertex_count)
+      : triangles_(triangles), begin_(vertex_count, kUnbuilt), end_(vertex_count, 0) {}
+
+  // v's star; `queued` are vertices soon examined too, built in the same batch.
+  std::span<const Corner> of(Index v, std::span<const Index> queued) {
+    if (begin_[v] == kUnbuilt) {
+      std::vector<Index> batch;
+      if (++batches_ > kBatches) {
+        for (Index u = 0; u < begin_.size(); ++u) {
+          if (begin_[u] == kUnbuilt) batch.push_back(u);
+        }
+        build(batch);
+      } else {
+        batch.push_back(v);
+        for (const Index u : queued) {
+          if (begin_[u] == kUnbuilt && u != v) batch.push_back(u);
+        }
+        build(batch);
+        std::vector<Index> ring;
+        for (const Index u : batch) {
+          for (std::uint32_t k = begin_[u]; k < end_[u]; ++k) {
+            for (const Index x : {corners_[k].u, corners_[k].w}) {
+              if (begin_[x] == kUnbuilt) {
+                begin_[x] = kWanted;
+                ring.push_back(x);
+              }
+            }
+          }
+        }
+        build(ring);
+      }
+    }
+    return {corners_.data() + begin_[v], corners_.data() + end_[v]};
+  }
+
+ private:
+  static constexpr std::uint32_t kUnbuilt = 0xFFFFFFFFu, kWanted = 0xFFFFFFFEu;
+  static constexpr int kBatches = 4;
+
+  // Two passes over the triangles: the stars' sizes, then their corners, appended in triangle
+  // order.
+  void build(std::span<const Index> batch) {
+    if (batch.empty()) return;
+    for (const Index u : batch) begin_[u] = kWanted, end_[u] = 0;
+    const auto wanted = [&](Index u) { return begin_[u] == kWanted; };
+    for (const Triangle& t : triangles_) {
+      for (const Index u : t) end_[u] += wanted(u);
+    }
+    auto at = static_cast<std::uint32_t>(corners_.size());
+    std::vector<std::uint32_t> start(batch.size());
+    for (std::size_t i = 0; i < batch.size(); ++i) {
+      start[i] = at;
+      at += end_[batch[i]];
+      end_[batch[i]] = start[i];  // the fill position, until the second pass ends
+    }
+    corners_.resize(at);
+    for (std::uint32_t t = 0; t < triangles_.size(); ++t) {
+      const Triangle& c = triangles_[t];
+      if (wanted(c[0])) corners_[end_[c[0]]++] = {t, c[1], c[2]};
+      if (wanted(c[1])) corners_[end_[c[1]]++] = {t, c[0], c[2]};
+      if (wanted(c[2])) corners_[end_[c[2]]++] = {t, c[0], c[1]};
+    }
+    for (std::size_t i = 0; i < batch.size(); ++i) begin_[batch[i]] = start[i];
+  }
+
+  std::span<const Triangle> triangles_;
+  std::vector<std::uint32_t> begin_, end_;
+  std::vector<Corner> corners_;
+  int batches_ = 0;
+};
+
+}  // namespace
+
 // finished empty: every vertex is finished.
 NonManifoldReport mark_non_manifold_fans(std::span<const Triangle> triangles,
                                          std::size_t vertex_count, std::span<const Index> suspects,
@@ -22,27 +109,7 @@ NonManifoldReport mark_non_manifold_fans(std::span<const Triangle> triangles,
   const std::size_t nt = triangles.size();
   dead.assign(nt, 0);
   if (suspects.empty()) return report;
-  // CSR: vertex -> incident triangles, each with its two other corners, so that walking a star
-  // reads one contiguous range instead of every triangle at random.
-  struct Corner {
-    std::uint32_t triangle;
-    Index u, w;  // the triangle's other corners, in the triangle's order
-  };
-  std::vector<std::uint32_t> start(vertex_count + 1, 0);
-  for (const Triangle& t : triangles) {
-    for (Index v : t) ++start[v + 1];
-  }
-  std::partial_sum(start.begin(), start.end(), start.begin());
-  std::vector<Corner> star(start.back());
-  {
-    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-    for (std::uint32_t t = 0; t < nt; ++t) {
-      const Triangle& c = triangles[t];
-      star[fill[c[0]]++] = {t, c[1], c[2]};
-      star[fill[c[1]]++] = {t, c[0], c[2]};
-      star[fill[c[2]]++] = {t, c[0], c[1]};
-    }
-  }
+  Stars stars(triangles, vertex_count);
   // Suspects are examined in index order whatever order they arose in.
   std::vector<std::uint8_t> queued(vertex_count, 0);
   std::vector<Index> work(suspects.begin(), suspects.end());
@@ -61,8 +128,8 @@ NonManifoldReport mark_non_manifold_fans(std::span<const Triangle> triangles,
     work.pop_back();
     queued[v] = 0;
     tris.clear();
-    for (std::uint32_t k = start[v]; k < start[v + 1]; ++k) {
-      if (!dead[star[k].triangle]) tris.push_back(star[k]);
+    for (const Corner& corner : stars.of(v, work)) {
+      if (!dead[corner.triangle]) tris.push_back(corner);
     }
     if (tris.size() < 2) continue;
     const auto m = static_cast<std::uint32_t>(tris.size());
