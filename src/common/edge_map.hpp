@@ -132,6 +132,25 @@ class EdgeMap {
     --size_;
   }
 
+  // Calls visit(u, v) for every edge {u, v}, u < v, with one triangle: the lines in vertex
+  // order (one sequential read), then the spill table.
+  template <class Visit>
+  void for_each_open(Visit&& visit) const {
+    for (std::size_t lo = 0; lo < lines_.size(); ++lo) {
+      const Line& line = lines_[lo];
+      for (std::uint32_t k = 0; k < line.count; ++k) {
+        if (line.other[k] != kGap && !(line.value[k] & kClosed)) {
+          visit(static_cast<Index>(lo), line.other[k]);
+        }
+      }
+    }
+    for (std::size_t s = 0; s < spill_keys_.size(); ++s) {
+      if (spill_keys_[s] != kEmpty && !(spill_values_[s] & kClosed)) {
+        visit(static_cast<Index>(spill_keys_[s] >> 32), static_cast<Index>(spill_keys_[s]));
+      }
+    }
+  }
+
   std::size_t size() const { return size_; }
   std::size_t memory_bytes() const {
     return lines_.size() * sizeof(Line) + spill_keys_.size() * 12;

@@ -384,18 +384,13 @@ class Grower {
     std::vector<Triangle> filled;
     std::vector<OpenEdge> open;
     const auto grown = static_cast<std::uint32_t>(triangles_.size());
+    // The open edges' points, from one read of the Point-Edge Map: only a triangle with two of
+    // them can have an open edge, and only those are looked up.
+    std::vector<std::uint8_t> on_open(grid_.size(), 0);
+    edges_.for_each_open([&](Index u, Index v) { on_open[u] = on_open[v] = 1; });
     for (std::uint32_t t = 0; t < grown; ++t) {
-      if (t + 8 < grown) {
-        const Triangle& ahead = triangles_[t + 8];
-        for (int k = 0; k < 3; ++k) edges_.prefetch(ahead[k], ahead[(k + 1) % 3]);
-      }
       const Triangle& own = triangles_[t];
-      bool open_edge[3];
-      for (int k = 0; k < 3; ++k) {
-        open_edge[k] = !(edges_.find(own[k], own[(k + 1) % 3]) & EdgeMap::kClosed);
-      }
-      if (!open_edge[0] && !open_edge[1] && !open_edge[2]) continue;
-      // Which way the triangle faces is looked up only for the few on a hole.
+      if (on_open[own[0]] + on_open[own[1]] + on_open[own[2]] < 2) continue;
       const Triangle tri = facing(t);
       for (int k = 0; k < 3; ++k) {
         const Index u = tri[k], v = tri[(k + 1) % 3];

@@ -279,7 +279,7 @@ TEST(EdgeMap, SecondTriangleClosesTheEdgeAndKeepsTheFirst) {
   EXPECT_EQ(map.size(), 2u);
 }
 
-TEST(EdgeMap, RemovalsMatchStdMap) {
+TEST(EdgeMap, RemovalsAndOpenEdgesMatchStdMap) {
   // Vertices with many edges (so that lines fill and spill), triangles added and taken off at
   // random: after every step the map agrees with a count of triangles per edge.
   EdgeMap map(50);
@@ -308,6 +308,14 @@ TEST(EdgeMap, RemovalsMatchStdMap) {
         present += triangles > 0;
       }
       ASSERT_EQ(map.size(), present);
+      // The open edges, each once.
+      std::vector<std::pair<Index, Index>> open, expected;
+      map.for_each_open([&](Index a, Index b) { open.push_back({a, b}); });
+      for (const auto& [edge, triangles] : model) {
+        if (triangles == 1) expected.push_back(edge);
+      }
+      std::sort(open.begin(), open.end());
+      ASSERT_EQ(open, expected) << step;
     }
   }
 }
