@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <numbers>
 #include <optional>
 #include <span>
@@ -22,6 +23,7 @@
 #include "grow/crossings.hpp"
 #include "grow/gabriel_walk.hpp"
 #include "grow/hole_filling.hpp"
+#include "grow/tangent_planes.hpp"
 
 namespace g2s {
 namespace {
@@ -55,6 +57,13 @@ Index apex(const Triangle& t, Index u, Index v) {
   return kNoIndex;
 }
 
+// The bound of the one-sheet test in radians; 0: off.
+double sheet_bound_rad(const MeshOptions& options) {
+  double deg = options.sheet_bound_deg;
+  if (const char* env = std::getenv("G2S_SHEET_DEG")) deg = std::atof(env);  // EXPERIMENT
+  return deg > 0 && deg < 90 ? deg * std::numbers::pi / 180.0 : 0.0;
+}
+
 class Grower {
  public:
   Grower(const HashGrid& grid, const MeshOptions& options, const GrowContext& context)
@@ -73,7 +82,8 @@ class Grower {
         max_fold_(options.max_fold_deg * std::numbers::pi / 180.0),
         cos_max_fold_(std::cos(max_fold_)),
         radius_floor_(0.5 * grid.spacing()),
-        radius_cap_(options.max_radius * grid.spacing()) {
+        radius_cap_(options.max_radius * grid.spacing()),
+        planes_(grid, sheet_bound_rad(options)) {
     // Noisy scans grow up to about three triangles a point before the clean-up; reserving more
     // costs only address space (pages are touched as triangles come) and saves copying.
     const std::size_t expected = std::size_t{4} * grid.size();
@@ -93,6 +103,8 @@ class Grower {
     for (std::uint32_t i = 0; i < grid_.size(); ++i) {
       if (used(i) || seed_tried_[i] || !growable(i)) continue;
       seed_tried_[i] = 1;
+      if (seed_rule_ && within_sheet(i)) continue;
+      if (middle_ > 0 && planes_.at(i).off_middle > middle_) continue;
       if (!try_seed(i)) continue;
       ++result.seeds;
       drain();
@@ -751,6 +763,11 @@ class Grower {
     if (len >= radius_cap_) return {};
     const Vec3 mid = (a + b) * 0.5;
     const Vec3 out = normalized(cross(ab, n));
+    // The tangent planes at a and b (one sheet through thick layers): candidates that would
+    // make a triangle standing steep to either are not seen by the walk.
+    const bool sheet = planes_.enabled() && sheet_bound_rad(options_) > 0;
+    const TangentPlane plane_a = sheet ? planes_.at(e.a) : TangentPlane{};
+    const TangentPlane plane_b = sheet ? planes_.at(e.b) : TangentPlane{};
     const double base = std::max(len, radius_floor_);
     auto ball_of = [&](int level, double& along) {
       const double radius =
@@ -778,6 +795,11 @@ class Grower {
         const double ahead = dot(d, out);
         if (ahead <= 0) return;
         if (within && !within->visits(grid_, j)) return;
+        if (middle_ > 0 && planes_.at(j).off_middle > middle_) return;
+        if (sheet && sheet_mode_ == 0) {
+          const Vec3 w = cross(a - b, q - b);
+          if (TangentPlanes::steep(plane_a, w) || TangentPlanes::steep(plane_b, w)) return;
+        }
         pool_.push_back({{q, norm2(d), j}, ahead});
       });
     };
@@ -807,6 +829,27 @@ class Grower {
       if (p == kNoIndex) continue;
       const Vec3 n_new = normalized(cross(a - b, grid_.position(p) - b));
       const int flat = flatness(std::clamp(dot(n, n_new), -1.0, 1.0));
+      if (flat >= 0 && growable(p) && sheet && sheet_mode_ == 6) {
+        int tilt = 0;
+        for (const TangentPlane* pl : {&plane_a, &plane_b}) {
+          if (pl->cos_limit <= 0) continue;
+          const double cos_tilt = std::min(1.0, std::abs(dot(n_new, Vec3(pl->normal))));
+          tilt = std::max(tilt, std::min(flat_levels_ - 1,
+                                         static_cast<int>(std::acos(cos_tilt) /
+                                                          (std::numbers::pi / 2) * flat_levels_)));
+        }
+        return {p, level * flat_levels_ + std::max(flat, tilt)};
+      }
+      if (flat >= 0 && growable(p) && sheet && sheet_mode_ > 0) {
+        const Vec3 w = cross(a - b, grid_.position(p) - b);
+        if (TangentPlanes::steep(plane_a, w) || TangentPlanes::steep(plane_b, w) ||
+            (sheet_mode_ >= 4 && TangentPlanes::steep(planes_.at(p), w))) {
+          if (sheet_mode_ == 1 || sheet_mode_ == 4)
+            return {p, level * flat_levels_ + flat_levels_ - 1};
+          if (sheet_mode_ == 2 || sheet_mode_ == 5) return {p, last_priority_};
+          continue;
+        }
+      }
       if (flat >= 0 && growable(p)) return {p, level * flat_levels_ + flat};
       // A fold, or context the run may not use: the next level may find another point.
     }
@@ -866,6 +909,12 @@ class Grower {
     }
     add_triangle(e.b, e.a, p, group_[e.triangle], flip_[e.triangle]);
     return true;
+  }
+
+  bool within_sheet(Index i) const {
+    const Index j = grid_.nearest(i, 4.0 * std::max(grid_.spacing(), 1e-30),
+                                  [](std::uint32_t) { return true; });
+    return j != kNoIndex && interior(j);
   }
 
   // A seed triangle (docs/algorithm.md §2): point i, its nearest unused neighbour, and the nearest
@@ -957,6 +1006,10 @@ class Grower {
   std::vector<WalkPoint> cand_;
   std::vector<Index> excluded_;  // points a retried edge has already failed with
   std::vector<std::pair<double, std::uint32_t>> near_;
+  TangentPlanes planes_;
+  double middle_ = std::getenv("G2S_MIDDLE") ? std::atof(std::getenv("G2S_MIDDLE")) : 0;
+  int seed_rule_ = std::getenv("G2S_SEED_RULE") ? std::atoi(std::getenv("G2S_SEED_RULE")) : 0;
+  int sheet_mode_ = std::getenv("G2S_SHEET_MODE") ? std::atoi(std::getenv("G2S_SHEET_MODE")) : 0;
 };
 
 }  // namespace
