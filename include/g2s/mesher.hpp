@@ -21,10 +21,10 @@ struct MeshOptions {
   // A new triangle whose normal turns more than this from its front neighbour's is a fold.
   double max_fold_deg = 135.0;
   // One sheet through thick or layered regions (docs/algorithm.md, "One sheet through thick
-  // layers"): a front does not grow a triangle whose normal turns more than this (plus the
-  // plane fit's own uncertainty) from the tangent plane fitted to the nearest points of its
-  // edge's ends. 0 (or 90 and more): no such test.
-  double sheet_bound_deg = 60.0;
+  // layers"): where a point's neighbourhood is a layer thicker than the spacing, a point more
+  // than two standard deviations off the layer's middle joins no triangle. Off: every point
+  // may join.
+  bool one_sheet = true;
   // No search ball is larger than this many spacings (the median nearest-neighbour distance):
   // fronts do not bridge voids, and a query never scans a large part of the cloud.
   double max_radius = 6.0;

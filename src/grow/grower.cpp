@@ -23,7 +23,7 @@
 #include "grow/crossings.hpp"
 #include "grow/gabriel_walk.hpp"
 #include "grow/hole_filling.hpp"
-#include "grow/tangent_planes.hpp"
+#include "grow/off_sheet.hpp"
 
 namespace g2s {
 namespace {
@@ -57,13 +57,6 @@ Index apex(const Triangle& t, Index u, Index v) {
   return kNoIndex;
 }
 
-// The bound of the one-sheet test in radians; 0: off.
-double sheet_bound_rad(const MeshOptions& options) {
-  double deg = options.sheet_bound_deg;
-  if (const char* env = std::getenv("G2S_SHEET_DEG")) deg = std::atof(env);  // EXPERIMENT
-  return deg > 0 && deg < 90 ? deg * std::numbers::pi / 180.0 : 0.0;
-}
-
 class Grower {
  public:
   Grower(const HashGrid& grid, const MeshOptions& options, const GrowContext& context)
@@ -83,7 +76,7 @@ class Grower {
         cos_max_fold_(std::cos(max_fold_)),
         radius_floor_(0.5 * grid.spacing()),
         radius_cap_(options.max_radius * grid.spacing()),
-        planes_(grid, sheet_bound_rad(options)) {
+        off_sheet_(options.one_sheet ? off_sheet_points(grid) : std::vector<std::uint8_t>{}) {
     // Noisy scans grow up to about three triangles a point before the clean-up; reserving more
     // costs only address space (pages are touched as triangles come) and saves copying.
     const std::size_t expected = std::size_t{4} * grid.size();
@@ -101,12 +94,19 @@ class Grower {
     load(context.preload, context.preload_group, context.preload_links);
     drain();
     for (std::uint32_t i = 0; i < grid_.size(); ++i) {
-      if (used(i) || seed_tried_[i] || !growable(i)) continue;
+      if (used(i) || seed_tried_[i] || !growable(i) || off_sheet(i)) continue;
       seed_tried_[i] = 1;
-      if (seed_rule_ && within_sheet(i)) continue;
-      if (middle_ > 0 && planes_.at(i).off_middle > middle_) continue;
       if (!try_seed(i)) continue;
       ++result.seeds;
+      drain();
+    }
+    if (std::getenv("G2S_SECOND") && !off_sheet_.empty()) {  // EXPERIMENT
+      off_sheet_.clear();
+      std::vector<FrontEdge> again;
+      again.swap(stalled_);
+      for (const FrontEdge& e : again) {
+        if (edges_.find(e.a, e.b) == e.triangle) queue_.push(0, e);
+      }
       drain();
     }
     if (options_.close_gaps) close_three_edge_gaps();
@@ -129,6 +129,9 @@ class Grower {
   bool interior(Index i) const { return state_[i] == kUsed; }
   bool growable(Index i) const { return growable_.empty() || growable_[i]; }
   bool fillable(Index i) const { return growable(i) && (fillable_.empty() || fillable_[i]); }
+  // An unused point off the sheet of a thick layer (off_sheet.hpp): growth leaves it out, as if
+  // it were not there.
+  bool off_sheet(Index i) const { return !off_sheet_.empty() && off_sheet_[i] && !used(i); }
 
   // Enters the triangles kept before this run, each its own orientation group (joined where they
   // share an edge, and as `links` say); their open edges at growable points become the front.
@@ -763,11 +766,6 @@ class Grower {
     if (len >= radius_cap_) return {};
     const Vec3 mid = (a + b) * 0.5;
     const Vec3 out = normalized(cross(ab, n));
-    // The tangent planes at a and b (one sheet through thick layers): candidates that would
-    // make a triangle standing steep to either are not seen by the walk.
-    const bool sheet = planes_.enabled() && sheet_bound_rad(options_) > 0;
-    const TangentPlane plane_a = sheet ? planes_.at(e.a) : TangentPlane{};
-    const TangentPlane plane_b = sheet ? planes_.at(e.b) : TangentPlane{};
     const double base = std::max(len, radius_floor_);
     auto ball_of = [&](int level, double& along) {
       const double radius =
@@ -788,18 +786,13 @@ class Grower {
     auto gather = [&](const HashGrid::BallQuery& query, const HashGrid::BallQuery* within) {
       pool_.clear();
       grid_.for_each_in_ball(query, [&](std::uint32_t j, double) {
-        if (j == e.a || j == e.b || j == c || interior(j)) return;
+        if (j == e.a || j == e.b || j == c || interior(j) || off_sheet(j)) return;
         if (std::find(excluded_.begin(), excluded_.end(), j) != excluded_.end()) return;
         const Vec3 q = grid_.position(j);
         const Vec3 d = q - mid;
         const double ahead = dot(d, out);
         if (ahead <= 0) return;
         if (within && !within->visits(grid_, j)) return;
-        if (middle_ > 0 && planes_.at(j).off_middle > middle_) return;
-        if (sheet && sheet_mode_ == 0) {
-          const Vec3 w = cross(a - b, q - b);
-          if (TangentPlanes::steep(plane_a, w) || TangentPlanes::steep(plane_b, w)) return;
-        }
         pool_.push_back({{q, norm2(d), j}, ahead});
       });
     };
@@ -829,27 +822,6 @@ class Grower {
       if (p == kNoIndex) continue;
       const Vec3 n_new = normalized(cross(a - b, grid_.position(p) - b));
       const int flat = flatness(std::clamp(dot(n, n_new), -1.0, 1.0));
-      if (flat >= 0 && growable(p) && sheet && sheet_mode_ == 6) {
-        int tilt = 0;
-        for (const TangentPlane* pl : {&plane_a, &plane_b}) {
-          if (pl->cos_limit <= 0) continue;
-          const double cos_tilt = std::min(1.0, std::abs(dot(n_new, Vec3(pl->normal))));
-          tilt = std::max(tilt, std::min(flat_levels_ - 1,
-                                         static_cast<int>(std::acos(cos_tilt) /
-                                                          (std::numbers::pi / 2) * flat_levels_)));
-        }
-        return {p, level * flat_levels_ + std::max(flat, tilt)};
-      }
-      if (flat >= 0 && growable(p) && sheet && sheet_mode_ > 0) {
-        const Vec3 w = cross(a - b, grid_.position(p) - b);
-        if (TangentPlanes::steep(plane_a, w) || TangentPlanes::steep(plane_b, w) ||
-            (sheet_mode_ >= 4 && TangentPlanes::steep(planes_.at(p), w))) {
-          if (sheet_mode_ == 1 || sheet_mode_ == 4)
-            return {p, level * flat_levels_ + flat_levels_ - 1};
-          if (sheet_mode_ == 2 || sheet_mode_ == 5) return {p, last_priority_};
-          continue;
-        }
-      }
       if (flat >= 0 && growable(p)) return {p, level * flat_levels_ + flat};
       // A fold, or context the run may not use: the next level may find another point.
     }
@@ -911,18 +883,12 @@ class Grower {
     return true;
   }
 
-  bool within_sheet(Index i) const {
-    const Index j = grid_.nearest(i, 4.0 * std::max(grid_.spacing(), 1e-30),
-                                  [](std::uint32_t) { return true; });
-    return j != kNoIndex && interior(j);
-  }
-
   // A seed triangle (docs/algorithm.md §2): point i, its nearest unused neighbour, and the nearest
   // third point that makes a Gabriel triangle whose circumcircle's cylinder is not cut by points
   // on both sides (it does not bridge a thin part).
   bool try_seed(Index i) {
     const double spacing = std::max(grid_.spacing(), 1e-30);
-    const auto unused = [&](std::uint32_t j) { return !used(j) && growable(j); };
+    const auto unused = [&](std::uint32_t j) { return !used(j) && growable(j) && !off_sheet(j); };
     const Index q = grid_.nearest(i, 4.0 * spacing, unused);
     if (q == kNoIndex) return false;
     const Vec3 p0 = grid_.position(i), p1 = grid_.position(q);
@@ -935,7 +901,7 @@ class Grower {
     std::sort(near_.begin(), near_.end());
     for (const auto& candidate : near_) {
       const std::uint32_t r = candidate.second;  // a named variable: lambdas below capture it
-      if (r == i || r == q || used(r) || !growable(r)) continue;
+      if (r == i || r == q || used(r) || !growable(r) || off_sheet(r)) continue;
       const Vec3 p2 = grid_.position(r);
       Ball ball;
       if (!circumball(p0, p1, p2, ball)) continue;
@@ -943,7 +909,7 @@ class Grower {
       const double reach = std::sqrt(ball.radius2) + norm(ball.centre - mid);
       bool gabriel = true;
       const auto check = [&](std::uint32_t j) {
-        if (j == i || j == q || j == r) return;
+        if (j == i || j == q || j == r || off_sheet(j)) return;
         if (norm2(grid_.position(j) - ball.centre) < ball.radius2 - tol) gabriel = false;
       };
       if (reach <= radius) {
@@ -1006,10 +972,8 @@ class Grower {
   std::vector<WalkPoint> cand_;
   std::vector<Index> excluded_;  // points a retried edge has already failed with
   std::vector<std::pair<double, std::uint32_t>> near_;
-  TangentPlanes planes_;
-  double middle_ = std::getenv("G2S_MIDDLE") ? std::atof(std::getenv("G2S_MIDDLE")) : 0;
-  int seed_rule_ = std::getenv("G2S_SEED_RULE") ? std::atoi(std::getenv("G2S_SEED_RULE")) : 0;
-  int sheet_mode_ = std::getenv("G2S_SHEET_MODE") ? std::atoi(std::getenv("G2S_SHEET_MODE")) : 0;
+  // Per point, 1: off the sheet of a thick layer (off_sheet.hpp); empty: one_sheet is off.
+  std::vector<std::uint8_t> off_sheet_;
 };
 
 }  // namespace
