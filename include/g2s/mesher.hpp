@@ -20,11 +20,6 @@ struct MeshOptions {
   int flatness_levels = 4;
   // A new triangle whose normal turns more than this from its front neighbour's is a fold.
   double max_fold_deg = 135.0;
-  // One sheet through thick or layered regions (docs/algorithm.md, "One sheet through thick
-  // layers"): where a point's neighbourhood is a layer thicker than the spacing, a point more
-  // than two standard deviations off the layer's middle joins no triangle. Off: every point
-  // may join.
-  bool one_sheet = true;
   // No search ball is larger than this many spacings (the median nearest-neighbour distance):
   // fronts do not bridge voids, and a query never scans a large part of the cloud.
   double max_radius = 6.0;

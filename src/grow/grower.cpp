@@ -11,7 +11,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <numbers>
 #include <optional>
 #include <span>
@@ -23,7 +22,6 @@
 #include "grow/crossings.hpp"
 #include "grow/gabriel_walk.hpp"
 #include "grow/hole_filling.hpp"
-#include "grow/off_sheet.hpp"
 
 namespace g2s {
 namespace {
@@ -75,8 +73,7 @@ class Grower {
         max_fold_(options.max_fold_deg * std::numbers::pi / 180.0),
         cos_max_fold_(std::cos(max_fold_)),
         radius_floor_(0.5 * grid.spacing()),
-        radius_cap_(options.max_radius * grid.spacing()),
-        off_sheet_(options.one_sheet ? off_sheet_points(grid) : std::vector<std::uint8_t>{}) {
+        radius_cap_(options.max_radius * grid.spacing()) {
     // Noisy scans grow up to about three triangles a point before the clean-up; reserving more
     // costs only address space (pages are touched as triangles come) and saves copying.
     const std::size_t expected = std::size_t{4} * grid.size();
@@ -94,19 +91,10 @@ class Grower {
     load(context.preload, context.preload_group, context.preload_links);
     drain();
     for (std::uint32_t i = 0; i < grid_.size(); ++i) {
-      if (used(i) || seed_tried_[i] || !growable(i) || off_sheet(i)) continue;
+      if (used(i) || seed_tried_[i] || !growable(i)) continue;
       seed_tried_[i] = 1;
       if (!try_seed(i)) continue;
       ++result.seeds;
-      drain();
-    }
-    if (std::getenv("G2S_SECOND") && !off_sheet_.empty()) {  // EXPERIMENT
-      off_sheet_.clear();
-      std::vector<FrontEdge> again;
-      again.swap(stalled_);
-      for (const FrontEdge& e : again) {
-        if (edges_.find(e.a, e.b) == e.triangle) queue_.push(0, e);
-      }
       drain();
     }
     if (options_.close_gaps) close_three_edge_gaps();
@@ -129,9 +117,6 @@ class Grower {
   bool interior(Index i) const { return state_[i] == kUsed; }
   bool growable(Index i) const { return growable_.empty() || growable_[i]; }
   bool fillable(Index i) const { return growable(i) && (fillable_.empty() || fillable_[i]); }
-  // An unused point off the sheet of a thick layer (off_sheet.hpp): growth leaves it out, as if
-  // it were not there.
-  bool off_sheet(Index i) const { return !off_sheet_.empty() && off_sheet_[i] && !used(i); }
 
   // Enters the triangles kept before this run, each its own orientation group (joined where they
   // share an edge, and as `links` say); their open edges at growable points become the front.
@@ -786,7 +771,7 @@ class Grower {
     auto gather = [&](const HashGrid::BallQuery& query, const HashGrid::BallQuery* within) {
       pool_.clear();
       grid_.for_each_in_ball(query, [&](std::uint32_t j, double) {
-        if (j == e.a || j == e.b || j == c || interior(j) || off_sheet(j)) return;
+        if (j == e.a || j == e.b || j == c || interior(j)) return;
         if (std::find(excluded_.begin(), excluded_.end(), j) != excluded_.end()) return;
         const Vec3 q = grid_.position(j);
         const Vec3 d = q - mid;
@@ -888,7 +873,7 @@ class Grower {
   // on both sides (it does not bridge a thin part).
   bool try_seed(Index i) {
     const double spacing = std::max(grid_.spacing(), 1e-30);
-    const auto unused = [&](std::uint32_t j) { return !used(j) && growable(j) && !off_sheet(j); };
+    const auto unused = [&](std::uint32_t j) { return !used(j) && growable(j); };
     const Index q = grid_.nearest(i, 4.0 * spacing, unused);
     if (q == kNoIndex) return false;
     const Vec3 p0 = grid_.position(i), p1 = grid_.position(q);
@@ -901,7 +886,7 @@ class Grower {
     std::sort(near_.begin(), near_.end());
     for (const auto& candidate : near_) {
       const std::uint32_t r = candidate.second;  // a named variable: lambdas below capture it
-      if (r == i || r == q || used(r) || !growable(r) || off_sheet(r)) continue;
+      if (r == i || r == q || used(r) || !growable(r)) continue;
       const Vec3 p2 = grid_.position(r);
       Ball ball;
       if (!circumball(p0, p1, p2, ball)) continue;
@@ -909,7 +894,7 @@ class Grower {
       const double reach = std::sqrt(ball.radius2) + norm(ball.centre - mid);
       bool gabriel = true;
       const auto check = [&](std::uint32_t j) {
-        if (j == i || j == q || j == r || off_sheet(j)) return;
+        if (j == i || j == q || j == r) return;
         if (norm2(grid_.position(j) - ball.centre) < ball.radius2 - tol) gabriel = false;
       };
       if (reach <= radius) {
@@ -972,8 +957,6 @@ class Grower {
   std::vector<WalkPoint> cand_;
   std::vector<Index> excluded_;  // points a retried edge has already failed with
   std::vector<std::pair<double, std::uint32_t>> near_;
-  // Per point, 1: off the sheet of a thick layer (off_sheet.hpp); empty: one_sheet is off.
-  std::vector<std::uint8_t> off_sheet_;
 };
 
 }  // namespace
