@@ -362,6 +362,35 @@ TEST(Mesher, SphereWithOnePercentOutliersIsStillMeshedAsOneSurface) {
   }
 }
 
+// Two layers about a sampling spacing apart, as where overlapping range scans disagree (issue 16,
+// "one sheet through thick or layered regions"): two samplings of the sphere, the second scaled
+// out by one spacing, with noise. A surface through every point must fold between the layers;
+// the mesher makes one sheet through both (bench/results/2026-11-25-one-sheet.md: refusing the
+// triangles that stand steep to the layer left more holes), and it must stay a clean surface:
+// no crossing pair, manifold, consistently oriented, nearly every point a vertex and the points
+// left out within two spacings of the mesh.
+TEST(Mesher, TwoLayersASpacingApartMeshAsOneCleanSheet) {
+  g2s::SynthOptions o;
+  o.shape = SynthShape::sphere;
+  o.points = 10'000;
+  o.noise = 0.1;
+  PointCloud cloud = g2s::make_synthetic_cloud(o);
+  o.seed = 2;
+  const PointCloud outer = g2s::make_synthetic_cloud(o);
+  const double scale = 1 + g2s::synth_spacing(o);
+  for (const double v : outer.xyz) cloud.xyz.push_back(v * scale);
+  const PipelineMesh mesh = g2s::mesh_cloud(cloud);
+  const MeshStats s = stats_of(cloud, mesh.triangles);
+  const std::string name = "two spheres a spacing apart";
+  report(name, mesh, s);
+  expect_manifold(s, name);
+  EXPECT_EQ(s.crossing_pairs, 0u) << name;
+  EXPECT_GE(s.coverage, 0.97) << name;
+  EXPECT_EQ(s.off_mesh_within_2, s.off_mesh_points) << name << ": points left out far off";
+  // One sheet through both layers, not one sheet per layer (two nested spheres) or pieces.
+  EXPECT_LE(s.components, 3u) << name;
+}
+
 // Regression: a single far outlier once hung the spacing estimate (see grid_test.cpp,
 // HashGrid.CloudWithAFarOutlierIsBuiltAndQueriedQuickly). A stray return far away is ordinary
 // input: it must mesh in milliseconds like the sphere alone.
