@@ -6,6 +6,7 @@
 // a worklist. Each deletion is final, so the total work is linear in the mesh size.
 #include <algorithm>
 #include <functional>
+#include <memory>
 #include <numeric>
 
 #include "cleanup/cleanup.hpp"
@@ -20,38 +21,39 @@ struct Corner {
   Index u, w;
 };
 
-// Per vertex, its triangles in index order, built only for the vertices examined: a batch of
-// vertices (with every corner of their triangles, since a deletion queues those) per pass over
-// the triangles, so that a cleanup near a few suspects does not pay for every vertex's star.
-// After kBatches batches the rest are built at once.
+// Per vertex, its triangles in index order. Near a few suspects only the stars examined are
+// built, in one batch (the queued vertices with every corner of their triangles, since a
+// deletion queues those) by passes over the triangles that mostly only read; a vertex outside
+// it, or many suspects (one in 64 vertices), has every star built at once.
 class Stars {
  public:
-  Stars(std::span<const Triangle> triangles, std::size_t vertex_count)
-      : triangles_(triangles), begin_(vertex_count, kUnbuilt), end_(vertex_count, 0) {}
+  Stars(std::span<const Triangle> triangles, std::size_t vertex_count, std::size_t suspects)
+      : triangles_(triangles),
+        state_(vertex_count, kUnbuilt),
+        begin_(std::make_unique_for_overwrite<std::uint32_t[]>(vertex_count)),
+        end_(std::make_unique_for_overwrite<std::uint32_t[]>(vertex_count)) {
+    if (suspects * 64 > vertex_count) build_all();
+  }
 
-  // v's star; `queued` are vertices soon examined too, built in the same batch.
+  // v's star; `queued` are the vertices to be examined after it.
   std::span<const Corner> of(Index v, std::span<const Index> queued) {
-    if (begin_[v] == kUnbuilt) {
-      std::vector<Index> batch;
-      if (++batches_ > kBatches) {
-        for (Index u = 0; u < begin_.size(); ++u) {
-          if (begin_[u] == kUnbuilt) batch.push_back(u);
-        }
-        build(batch);
+    if (state_[v] != kBuilt) {
+      if (batched_) {
+        build_all();
       } else {
-        batch.push_back(v);
+        batched_ = true;
+        std::vector<Index> batch{v};
         for (const Index u : queued) {
-          if (begin_[u] == kUnbuilt && u != v) batch.push_back(u);
+          if (state_[u] == kUnbuilt) batch.push_back(u);
         }
         build(batch);
         std::vector<Index> ring;
         for (const Index u : batch) {
           for (std::uint32_t k = begin_[u]; k < end_[u]; ++k) {
             for (const Index x : {corners_[k].u, corners_[k].w}) {
-              if (begin_[x] == kUnbuilt) {
-                begin_[x] = kWanted;
-                ring.push_back(x);
-              }
+              if (state_[x] != kUnbuilt) continue;
+              state_[x] = kWanted;
+              ring.push_back(x);
             }
           }
         }
@@ -62,39 +64,47 @@ class Stars {
   }
 
  private:
-  static constexpr std::uint32_t kUnbuilt = 0xFFFFFFFFu, kWanted = 0xFFFFFFFEu;
-  static constexpr int kBatches = 4;
+  enum : std::uint8_t { kUnbuilt, kWanted, kBuilt };
+
+  void build_all() {
+    std::vector<Index> rest;
+    for (std::size_t u = 0; u < state_.size(); ++u) {
+      if (state_[u] == kUnbuilt) rest.push_back(static_cast<Index>(u));
+    }
+    build(rest);
+  }
 
   // Two passes over the triangles: the stars' sizes, then their corners, appended in triangle
   // order.
   void build(std::span<const Index> batch) {
     if (batch.empty()) return;
-    for (const Index u : batch) begin_[u] = kWanted, end_[u] = 0;
-    const auto wanted = [&](Index u) { return begin_[u] == kWanted; };
+    for (const Index u : batch) state_[u] = kWanted, end_[u] = 0;
     for (const Triangle& t : triangles_) {
-      for (const Index u : t) end_[u] += wanted(u);
+      for (const Index u : t) {
+        if (state_[u] == kWanted) ++end_[u];
+      }
     }
     auto at = static_cast<std::uint32_t>(corners_.size());
-    std::vector<std::uint32_t> start(batch.size());
-    for (std::size_t i = 0; i < batch.size(); ++i) {
-      start[i] = at;
-      at += end_[batch[i]];
-      end_[batch[i]] = start[i];  // the fill position, until the second pass ends
+    for (const Index u : batch) {
+      begin_[u] = at;
+      at += end_[u];
+      end_[u] = begin_[u];  // the fill position, until the second pass ends
     }
     corners_.resize(at);
     for (std::uint32_t t = 0; t < triangles_.size(); ++t) {
       const Triangle& c = triangles_[t];
-      if (wanted(c[0])) corners_[end_[c[0]]++] = {t, c[1], c[2]};
-      if (wanted(c[1])) corners_[end_[c[1]]++] = {t, c[0], c[2]};
-      if (wanted(c[2])) corners_[end_[c[2]]++] = {t, c[0], c[1]};
+      if (state_[c[0]] == kWanted) corners_[end_[c[0]]++] = {t, c[1], c[2]};
+      if (state_[c[1]] == kWanted) corners_[end_[c[1]]++] = {t, c[0], c[2]};
+      if (state_[c[2]] == kWanted) corners_[end_[c[2]]++] = {t, c[0], c[1]};
     }
-    for (std::size_t i = 0; i < batch.size(); ++i) begin_[batch[i]] = start[i];
+    for (const Index u : batch) state_[u] = kBuilt;
   }
 
   std::span<const Triangle> triangles_;
-  std::vector<std::uint32_t> begin_, end_;
+  std::vector<std::uint8_t> state_;
+  std::unique_ptr<std::uint32_t[]> begin_, end_;
   std::vector<Corner> corners_;
-  int batches_ = 0;
+  bool batched_ = false;
 };
 
 }  // namespace
@@ -109,7 +119,7 @@ NonManifoldReport mark_non_manifold_fans(std::span<const Triangle> triangles,
   const std::size_t nt = triangles.size();
   dead.assign(nt, 0);
   if (suspects.empty()) return report;
-  Stars stars(triangles, vertex_count);
+  Stars stars(triangles, vertex_count, suspects.size());
   // Suspects are examined in index order whatever order they arose in.
   std::vector<std::uint8_t> queued(vertex_count, 0);
   std::vector<Index> work(suspects.begin(), suspects.end());
