@@ -8,7 +8,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 
 #include "common/exact_predicates.hpp"
@@ -126,13 +125,6 @@ RunCrossings find_crossings(const HashGrid& grid, std::span<const Triangle> tria
   // Each uncertified triangle against the triangles on the vertices in its ball. A pair where
   // each ball holds a corner of the other is met from both sides; the larger index leaves it
   // to the smaller.
-  const auto box_of = [&](const Triangle& t) {
-    const Vec3f &p0 = grid.point(t[0]), &p1 = grid.point(t[1]), &p2 = grid.point(t[2]);
-    return std::array<Vec3f, 2>{Vec3f{std::min({p0.x, p1.x, p2.x}), std::min({p0.y, p1.y, p2.y}),
-                                      std::min({p0.z, p1.z, p2.z})},
-                                Vec3f{std::max({p0.x, p1.x, p2.x}), std::max({p0.y, p1.y, p2.y}),
-                                      std::max({p0.z, p1.z, p2.z})}};
-  };
   const auto holds_corner_of = [&](const Triangle& s, const Triangle& t) {
     Ball ball;
     ball_of(s, ball);
@@ -152,20 +144,16 @@ RunCrossings find_crossings(const HashGrid& grid, std::span<const Triangle> tria
                         const auto& [part, run] = uncertified[u];
                         const std::uint32_t id = run.triangle;
                         const Triangle& tri = triangles[id];
-                        const auto box = box_of(tri);
+                        const Box box = box_of(grid.points(), tri);
                         near.clear();
                         for (std::uint32_t k = run.begin; k < run.end; ++k) {
                           const Index v = part->vertices[k];
                           for (std::uint32_t s = star_begin[v]; s < star_begin[v + 1]; ++s) {
                             const std::uint32_t other = star[s];
                             if (other == id || !has_ball[other]) continue;
-                            const auto other_box = box_of(triangles[other]);
-                            if (other_box[0].x > box[1].x || box[0].x > other_box[1].x ||
-                                other_box[0].y > box[1].y || box[0].y > other_box[1].y ||
-                                other_box[0].z > box[1].z || box[0].z > other_box[1].z) {
-                              continue;
+                            if (overlap(box, box_of(grid.points(), triangles[other]))) {
+                              near.push_back(other);
                             }
-                            near.push_back(other);
                           }
                         }
                         std::sort(near.begin(), near.end());
@@ -316,13 +304,7 @@ TriangleCells::TriangleCells(std::span<const Vec3f> points, std::span<const Tria
       level_(triangles.size(), 0) {
   std::vector<float> extents(triangles.size());
   for (std::uint32_t t = 0; t < triangles.size(); ++t) {
-    const Triangle& tri = triangles[t];
-    const Vec3f &p0 = points[tri[0]], &p1 = points[tri[1]], &p2 = points[tri[2]];
-    Box& box = boxes_[t];
-    box.lo = {std::min({p0.x, p1.x, p2.x}), std::min({p0.y, p1.y, p2.y}),
-              std::min({p0.z, p1.z, p2.z})};
-    box.hi = {std::max({p0.x, p1.x, p2.x}), std::max({p0.y, p1.y, p2.y}),
-              std::max({p0.z, p1.z, p2.z})};
+    const Box& box = boxes_[t] = box_of(points, triangles[t]);
     extents[t] = std::max({box.hi.x - box.lo.x, box.hi.y - box.lo.y, box.hi.z - box.lo.z});
   }
   // The first level's cell holds nine triangles in ten whole; the rest are few enough to be

@@ -30,6 +30,25 @@ bool padded_circumball(const Vec3& a, const Vec3& b, const Vec3& c, Ball& out);
 // (common/triangle_intersection.hpp). The same triangle twice never crosses.
 bool triangles_cross(std::span<const Vec3f> points, const Triangle& a, const Triangle& b);
 
+// An axis-aligned box: two triangles whose boxes do not overlap cannot cross.
+struct Box {
+  Vec3f lo, hi;
+};
+inline bool overlap(const Box& a, const Box& b) {
+  return a.lo.x <= b.hi.x && b.lo.x <= a.hi.x && a.lo.y <= b.hi.y && b.lo.y <= a.hi.y &&
+         a.lo.z <= b.hi.z && b.lo.z <= a.hi.z;
+}
+// The box of a point set grown to hold p.
+inline Box enclose(const Box& box, const Vec3f& p) {
+  return {{std::min(box.lo.x, p.x), std::min(box.lo.y, p.y), std::min(box.lo.z, p.z)},
+          {std::max(box.hi.x, p.x), std::max(box.hi.y, p.y), std::max(box.hi.z, p.z)}};
+}
+// The box of triangle t's corners.
+inline Box box_of(std::span<const Vec3f> points, const Triangle& t) {
+  const Box corner{points[t[0]], points[t[0]]};
+  return enclose(enclose(corner, points[t[1]]), points[t[2]]);
+}
+
 // The crossing pairs among the triangles of a run, and the triangles no search covers.
 struct RunCrossings {
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;  // (s, t), s < t, sorted
@@ -45,8 +64,9 @@ struct RunCrossings {
 // certified, and the others are tested against the triangles on the vertices in their balls;
 // on a clean scan nearly every triangle is certified. Points no triangle uses play no part, so
 // noise left out of the mesh does not spoil a certificate.
-// Inputs: grid (its points are the corners), triangles. Cost: one ball query per triangle, and
-// a second for each uncertified one; the pairs are the same for any thread count.
+// Inputs: grid (its points are the corners), triangles. Cost: one ball query per triangle (the
+// vertices found in the balls of uncertified ones are kept, and only their stars are built);
+// the pairs are the same for any thread count.
 RunCrossings find_crossings(const HashGrid& grid, std::span<const Triangle> triangles);
 
 // Whether triangles a and b, with their padded circumballs (padded_circumball; radius2 < 0 for
@@ -64,14 +84,6 @@ bool apart(std::span<const Vec3f> points, const Triangle& a, const Ball& a_ball,
 // object.
 class TriangleCells {
  public:
-  struct Box {
-    Vec3f lo, hi;
-  };
-  static bool overlap(const Box& a, const Box& b) {
-    return a.lo.x <= b.hi.x && b.lo.x <= a.hi.x && a.lo.y <= b.hi.y && b.lo.y <= a.hi.y &&
-           a.lo.z <= b.hi.z && b.lo.z <= a.hi.z;
-  }
-
   TriangleCells(std::span<const Vec3f> points, std::span<const Triangle> triangles);
 
   // Calls visit(t, box of t) once for every triangle whose bounding box overlaps the box

@@ -477,18 +477,11 @@ class Grower {
       if (!cells) cells.emplace(grid_.points(), std::span<const Triangle>(triangles_));
       // Every filling triangle lies in the loop's box: the grown triangles that may cross one
       // are those whose boxes overlap it, found once per loop.
-      detail::TriangleCells::Box loop_box{grid_.point(loop[0]), grid_.point(loop[0])};
-      for (const Index v : loop) {
-        const Vec3f& p = grid_.point(v);
-        loop_box.lo = {std::min(loop_box.lo.x, p.x), std::min(loop_box.lo.y, p.y),
-                       std::min(loop_box.lo.z, p.z)};
-        loop_box.hi = {std::max(loop_box.hi.x, p.x), std::max(loop_box.hi.y, p.y),
-                       std::max(loop_box.hi.z, p.z)};
-      }
+      detail::Box loop_box{grid_.point(loop[0]), grid_.point(loop[0])};
+      for (const Index v : loop) loop_box = detail::enclose(loop_box, grid_.point(v));
       loop_near_.clear();
       cells->for_each_near(
-          loop_box.lo, loop_box.hi,
-          [&](std::uint32_t other, const detail::TriangleCells::Box& box) {
+          loop_box.lo, loop_box.hi, [&](std::uint32_t other, const detail::Box& box) {
             const Triangle& o = triangles_[other];
             NearTriangle near{other, box, {}};
             if (!detail::padded_circumball(grid_.position(o[0]), grid_.position(o[1]),
@@ -618,15 +611,10 @@ class Grower {
   // grown triangles near the loop (loop_near_) and repeats none (the loop around a lone triangle
   // that touches the rest at a corner is a loop of its own).
   bool fill_fits(const Triangle& t) {
-    const Vec3f& p0 = grid_.point(t[0]);
-    const Vec3f& p1 = grid_.point(t[1]);
-    const Vec3f& p2 = grid_.point(t[2]);
-    const detail::TriangleCells::Box box{
-        {std::min({p0.x, p1.x, p2.x}), std::min({p0.y, p1.y, p2.y}), std::min({p0.z, p1.z, p2.z})},
-        {std::max({p0.x, p1.x, p2.x}), std::max({p0.y, p1.y, p2.y}), std::max({p0.z, p1.z, p2.z})}};
+    const detail::Box box = detail::box_of(grid_.points(), t);
     // Points this run may not use (a seam's context: tiles still to come) must not lie in
     // the triangle's circumball: the surface may yet be meshed over them. The same (padded)
-    // ball settles most neighbours by the power test (TriangleCells::apart).
+    // ball settles most neighbours by the power test (detail::apart).
     Ball ball;
     if (!detail::padded_circumball(grid_.position(t[0]), grid_.position(t[1]), grid_.position(t[2]),
                                    ball)) {
@@ -640,7 +628,7 @@ class Grower {
       if (covers_context) return false;
     }
     for (const NearTriangle& near : loop_near_) {
-      if (!detail::TriangleCells::overlap(box, near.box)) continue;
+      if (!detail::overlap(box, near.box)) continue;
       const Triangle& o = triangles_[near.index];
       if (std::is_permutation(o.begin(), o.end(), t.begin())) return false;
       if (!detail::apart(grid_.points(), t, ball, o, near.ball) &&
@@ -973,7 +961,7 @@ class Grower {
   // boxes and padded circumballs (radius2 < 0: none)
   struct NearTriangle {
     std::uint32_t index;
-    detail::TriangleCells::Box box;
+    detail::Box box;
     Ball ball;
   };
   std::vector<NearTriangle> loop_near_;

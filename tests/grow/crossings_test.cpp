@@ -83,7 +83,7 @@ bool cells_say_crosses(const Soup& soup, const detail::TriangleCells& cells,
     hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
   }
   bool crosses = false;
-  cells.for_each_near(lo, hi, [&](std::uint32_t other, const detail::TriangleCells::Box&) {
+  cells.for_each_near(lo, hi, [&](std::uint32_t other, const detail::Box&) {
     const Triangle& o = filed[other];
     Ball other_ball;
     EXPECT_TRUE(detail::padded_circumball(soup.grid.position(o[0]), soup.grid.position(o[1]),
