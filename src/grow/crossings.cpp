@@ -219,8 +219,8 @@ Pairs TriangleCells::crossing_pairs() const {
                     });
   // Triangles of the larger levels against everything near them (each pair of two such once).
   Pairs& pairs = found.local();
-  const auto against_all = [&](std::uint32_t t) {
-    for_each_near(boxes_[t].lo, boxes_[t].hi, [&](std::uint32_t other, const Box&) {
+  const auto against_all = [&](std::uint32_t t, const Box& box) {
+    for_each_near(box.lo, box.hi, [&](std::uint32_t other, const Box&) {
       if (other == t || (level_[other] != 0 && other < t)) return;
       if (collinear[t] || collinear[other]) return;
       if (triangles_cross(points_, triangles_[t], triangles_[other])) {
@@ -229,7 +229,8 @@ Pairs TriangleCells::crossing_pairs() const {
     });
   };
   for (std::size_t l = 1; l < levels_.size(); ++l) {
-    for (const std::uint32_t t : levels_[l].filed) against_all(t);
+    const Level& level = levels_[l];
+    for (std::size_t e = 0; e < level.filed.size(); ++e) against_all(level.filed[e], level.boxes[e]);
   }
   return sorted_union(found);
 }
@@ -265,46 +266,70 @@ std::size_t TriangleCells::Level::find(std::uint64_t k) const {
 }
 
 void TriangleCells::build(Level& level, std::span<const std::uint32_t> members) {
-  std::size_t slots = 16;
+  const auto key_of = [&](std::uint32_t t) {
+    const Vec3f lo = box_of(points_, triangles_[t]).lo;
+    return key(level.coord(lo.x), level.coord(lo.y), level.coord(lo.z));
+  };
+  const auto home = [&](std::uint64_t k) {
+    return static_cast<std::size_t>((k * 0x9E3779B97F4A7C15ull) >> level.shift);
+  };
+  // The cells and their counts, the table doubled whenever it would be more than half full.
+  std::size_t cells = 0;
   level.shift = 60;
-  while (slots < 2 * members.size()) slots *= 2, --level.shift;
-  level.keys.assign(slots, kEmpty);
-  level.begin.assign(slots + 1, 0);
-  level.end.assign(slots, 0);
-  // Counting sort by slot: count, offsets, then place.
-  std::vector<std::uint32_t> slot_of(members.size());
-  for (std::size_t m = 0; m < members.size(); ++m) {
-    const Vec3f& lo = boxes_[members[m]].lo;
-    const std::uint64_t k = key(level.coord(lo.x), level.coord(lo.y), level.coord(lo.z));
-    std::size_t s = (k * 0x9E3779B97F4A7C15ull) >> level.shift;
-    while (level.keys[s] != kEmpty && level.keys[s] != k) s = (s + 1) & (slots - 1);
-    level.keys[s] = k;
-    slot_of[m] = static_cast<std::uint32_t>(s);
+  level.keys.assign(16, kEmpty);
+  level.end.assign(16, 0);
+  const auto slot_for = [&](std::uint64_t k) {
+    std::size_t s = home(k);
+    while (level.keys[s] != kEmpty && level.keys[s] != k) s = (s + 1) & (level.keys.size() - 1);
+    return s;
+  };
+  for (const std::uint32_t t : members) {
+    const std::uint64_t k = key_of(t);
+    std::size_t s = slot_for(k);
+    if (level.keys[s] == kEmpty) {
+      if (2 * (cells + 1) > level.keys.size()) {
+        std::vector<std::uint64_t> keys(2 * level.keys.size(), kEmpty);
+        std::vector<std::uint32_t> counts(keys.size(), 0);
+        keys.swap(level.keys);
+        counts.swap(level.end);
+        --level.shift;
+        for (std::size_t old = 0; old < keys.size(); ++old) {
+          if (keys[old] == kEmpty) continue;
+          const std::size_t moved = slot_for(keys[old]);
+          level.keys[moved] = keys[old];
+          level.end[moved] = counts[old];
+        }
+        s = slot_for(k);
+      }
+      level.keys[s] = k;
+      ++cells;
+    }
     ++level.end[s];
   }
+  // Counting sort by slot: offsets, then place.
+  const std::size_t slots = level.keys.size();
+  level.begin.assign(slots + 1, 0);
   std::uint32_t offset = 0;
   for (std::size_t s = 0; s < slots; ++s) {
     level.begin[s] = offset;
     offset += level.end[s];
     level.end[s] = level.begin[s];
   }
+  level.begin[slots] = offset;
   level.filed.resize(members.size());
   level.boxes.resize(members.size());
-  for (std::size_t m = 0; m < members.size(); ++m) {
-    const std::uint32_t at = level.end[slot_of[m]]++;
-    level.filed[at] = members[m];
-    level.boxes[at] = boxes_[members[m]];
+  for (const std::uint32_t t : members) {
+    const std::uint32_t at = level.end[level.find(key_of(t))]++;
+    level.filed[at] = t;
+    level.boxes[at] = box_of(points_, triangles_[t]);
   }
 }
 
 TriangleCells::TriangleCells(std::span<const Vec3f> points, std::span<const Triangle> triangles)
-    : points_(points),
-      triangles_(triangles),
-      boxes_(triangles.size()),
-      level_(triangles.size(), 0) {
+    : points_(points), triangles_(triangles), level_(triangles.size(), 0) {
   std::vector<float> extents(triangles.size());
   for (std::uint32_t t = 0; t < triangles.size(); ++t) {
-    const Box& box = boxes_[t] = box_of(points, triangles[t]);
+    const Box box = box_of(points, triangles[t]);
     extents[t] = std::max({box.hi.x - box.lo.x, box.hi.y - box.lo.y, box.hi.z - box.lo.z});
   }
   // The first level's cell holds nine triangles in ten whole; the rest are few enough to be
@@ -331,7 +356,11 @@ TriangleCells::TriangleCells(std::span<const Vec3f> points, std::span<const Tria
     level_[t] = static_cast<std::uint8_t>(l);
     members[l].push_back(t);
   }
-  for (std::size_t l = 0; l < levels_.size(); ++l) build(levels_[l], members[l]);
+  extents = {};
+  for (std::size_t l = 0; l < levels_.size(); ++l) {
+    build(levels_[l], members[l]);
+    members[l] = {};
+  }
 }
 
 }  // namespace g2s::detail

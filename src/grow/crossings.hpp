@@ -95,7 +95,8 @@ class TriangleCells {
   std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_pairs() const;
 
  private:
-  // One size of cell: per filed triangle, in cell order; cells in an open-addressing table.
+  // One size of cell: per filed triangle, in cell order; cells in an open-addressing table at
+  // most half full (sized by the cells, far fewer than the triangles).
   struct Level {
     double inverse_cell = 1;
     std::vector<std::uint64_t> keys;  // per slot: cell key, or kEmpty
@@ -117,7 +118,6 @@ class TriangleCells {
 
   std::span<const Vec3f> points_;
   std::span<const Triangle> triangles_;
-  std::vector<Box> boxes_;
   std::vector<std::uint8_t> level_;  // per triangle: the level it is filed in
   std::vector<Level> levels_;
 };
