@@ -230,7 +230,8 @@ Pairs TriangleCells::crossing_pairs() const {
   };
   for (std::size_t l = 1; l < levels_.size(); ++l) {
     const Level& level = levels_[l];
-    for (std::size_t e = 0; e < level.filed.size(); ++e) against_all(level.filed[e], level.boxes[e]);
+    for (std::size_t e = 0; e < level.filed.size(); ++e)
+      against_all(level.filed[e], level.boxes[e]);
   }
   return sorted_union(found);
 }
