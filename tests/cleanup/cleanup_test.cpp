@@ -287,6 +287,45 @@ TEST(NonManifoldRemoval, RandomlyDamagedTorusEndsWithoutNonManifoldVertices) {
   EXPECT_GT(fixed_total, 100u);  // the damage did create plenty of bow-ties to fix
 }
 
+TEST(NonManifoldRemoval, FewSuspectsOnALargeMeshAreJudgedFromTheirOwnStars) {
+  // As in the grower: a large mesh, and as suspects only the corners of the triangles removed.
+  // Two triangles of a vertex's star that share no edge at it are removed at 25 vertices far
+  // apart, each then a bow-tie of two open fans. Few suspects, so only their stars (and their
+  // neighbours') are built; every bow-tie must still be undone.
+  constexpr int nu = 200, nv = 100;
+  const Torus base = torus(nu, nv);
+  std::vector<std::uint8_t> drop(base.triangles.size(), 0);
+  for (int i = 5; i < nu; i += 40) {
+    for (int j = 5; j < nv; j += 20) {
+      drop[static_cast<std::size_t>(2 * (j * nu + i))] = 1;              // quad (i, j), first half
+      drop[static_cast<std::size_t>(2 * ((j - 1) * nu + (i - 1)))] = 1;  // quad (i-1, j-1)
+    }
+  }
+  std::vector<Triangle> tris;
+  std::vector<Index> suspects;
+  for (std::size_t t = 0; t < base.triangles.size(); ++t) {
+    if (!drop[t]) {
+      tris.push_back(base.triangles[t]);
+    } else {
+      suspects.insert(suspects.end(), base.triangles[t].begin(), base.triangles[t].end());
+    }
+  }
+  ASSERT_LT(suspects.size() * 64, base.points.size()) << "few enough suspects to build lazily";
+  ASSERT_EQ(stats_of(base.points, tris).non_manifold_vertices, 25u);
+  std::vector<std::uint8_t> dead;
+  std::vector<Index> deferred;
+  const g2s::NonManifoldReport report =
+      g2s::mark_non_manifold_fans(tris, base.points.size(), suspects, {}, dead, deferred);
+  std::vector<Triangle> kept;
+  for (std::size_t t = 0; t < tris.size(); ++t) {
+    if (!dead[t]) kept.push_back(tris[t]);
+  }
+  EXPECT_EQ(report.vertices_fixed, 25u);
+  EXPECT_EQ(report.triangles_removed, tris.size() - kept.size());
+  EXPECT_EQ(stats_of(base.points, kept).non_manifold_vertices, 0u);
+  EXPECT_EQ(stats_of(base.points, kept).non_manifold_edges, 0u);
+}
+
 TEST(NonManifoldRemoval, ManifoldMeshesAreLeftUntouched) {
   // Closed octahedron + closed torus + an open torus strip with a hole: all manifold.
   const Torus t = torus(24, 12);
