@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "common/linear_probing.hpp"
 #include "g2s/types.hpp"
 
 namespace g2s {
@@ -114,20 +115,8 @@ class EdgeMap {
       spill_values_[s] &= ~kClosed;
       return;
     }
-    // Backward-shift deletion: each later entry of the run moves into the gap unless its home
-    // slot lies cyclically after the gap, so every probe run stays unbroken.
-    const std::size_t mask = spill_keys_.size() - 1;
-    std::size_t gap = s;
-    for (std::size_t j = (s + 1) & mask; spill_keys_[j] != kEmpty; j = (j + 1) & mask) {
-      const std::size_t home = spill_slot(spill_keys_[j]);
-      if (((j - home) & mask) >= ((j - gap) & mask)) {
-        spill_keys_[gap] = spill_keys_[j];
-        spill_values_[gap] = spill_values_[j];
-        gap = j;
-      }
-    }
-    spill_keys_[gap] = kEmpty;
-    spill_values_[gap] = kMissing;
+    erase_slot(spill_keys_, spill_values_, s, kEmpty,
+               [this](std::uint64_t k) { return spill_slot(k); });
     --spill_size_;
     --size_;
   }

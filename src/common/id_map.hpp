@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "common/linear_probing.hpp"
 #include "g2s/types.hpp"
 
 namespace g2s {
@@ -46,16 +47,7 @@ class IdMap {
       if (keys_[hole] == kEmpty) return;
       hole = (hole + 1) & mask_;
     }
-    // Shift back the entries after the hole that may not stay past it.
-    for (std::size_t k = (hole + 1) & mask_; keys_[k] != kEmpty; k = (k + 1) & mask_) {
-      const std::size_t want = home(keys_[k]);
-      if (((k - want) & mask_) >= ((k - hole) & mask_)) {
-        keys_[hole] = keys_[k];
-        values_[hole] = values_[k];
-        hole = k;
-      }
-    }
-    keys_[hole] = kEmpty;
+    erase_slot(keys_, values_, hole, kEmpty, [this](Index key) { return home(key); });
     --size_;
   }
 

@@ -45,6 +45,22 @@ struct Ball {
   double radius2;
 };
 
+// Whether a triangle with edge vectors u = b - a, v = c - a (w = u x v) and third side c - b is
+// no sliver. The smallest angle lies between the two longest edges, and its squared sine is
+// |w|^2 over the product of their squared lengths. Below ~0.006 degrees the circumcentre is
+// numerically meaningless and, written out, the triangle may become exactly collinear.
+inline bool not_a_sliver(double w2, double uu, double vv, double cc) {
+  const double longest = std::max({uu, vv, cc});
+  const double second = uu + vv + cc - longest - std::min({uu, vv, cc});
+  return w2 > 1e-8 * longest * second;
+}
+
+// Whether a, b, c have a circumball (circumball would succeed).
+inline bool has_circumball(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 u = b - a, v = c - a;
+  return not_a_sliver(norm2(cross(u, v)), norm2(u), norm2(v), norm2(c - b));
+}
+
 inline bool circumball(const Vec3& a, const Vec3& b, const Vec3& c, Ball& out) {
   const Vec3 u = b - a;
   const Vec3 v = c - a;
@@ -52,13 +68,7 @@ inline bool circumball(const Vec3& a, const Vec3& b, const Vec3& c, Ball& out) {
   const double w2 = norm2(w);
   const double uu = norm2(u);
   const double vv = norm2(v);
-  const double cc = norm2(c - b);
-  // Reject slivers: the smallest angle lies between the two longest edges, and its squared sine
-  // is |w|^2 over the product of their squared lengths. Below ~0.006 degrees the circumcentre is
-  // numerically meaningless and, written out, the triangle may become exactly collinear.
-  const double longest = std::max({uu, vv, cc});
-  const double second = uu + vv + cc - longest - std::min({uu, vv, cc});
-  if (!(w2 > 1e-8 * longest * second)) return false;
+  if (!not_a_sliver(w2, uu, vv, norm2(c - b))) return false;
   const Vec3 offset = (cross(w, u) * vv + cross(v, w) * uu) * (0.5 / w2);
   out.centre = a + offset;
   out.radius2 = norm2(offset);

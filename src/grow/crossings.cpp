@@ -51,7 +51,7 @@ Pairs sorted_union(tbb::enumerable_thread_specific<Pairs>& found) {
 }
 }  // namespace
 
-RunCrossings find_crossings(const HashGrid& grid, std::span<const Triangle> triangles) {
+Pairs find_crossings(const HashGrid& grid, std::span<const Triangle> triangles) {
   const std::size_t n = grid.size();
   std::vector<std::uint8_t> vertex(n, 0);  // used by some triangle
   for (const Triangle& t : triangles) {
@@ -91,15 +91,11 @@ RunCrossings find_crossings(const HashGrid& grid, std::span<const Triangle> tria
                           local.runs.push_back({static_cast<std::uint32_t>(t), begin, end});
                       }
                     });
-  RunCrossings result;
-  for (std::uint32_t t = 0; t < triangles.size(); ++t) {
-    if (!has_ball[t]) result.without_ball.push_back(t);
-  }
   std::vector<std::pair<const Inside*, Run>> uncertified;
   for (const Inside& part : inside) {
     for (const Run& run : part.runs) uncertified.push_back({&part, run});
   }
-  if (uncertified.empty()) return result;
+  if (uncertified.empty()) return {};
   std::vector<std::uint8_t> uncertified_triangle(triangles.size(), 0);
   for (const auto& [part, run] : uncertified) uncertified_triangle[run.triangle] = 1;
   // The stars of the vertices in some uncertified ball: per such vertex, the triangles on it
@@ -169,8 +165,7 @@ RunCrossings find_crossings(const HashGrid& grid, std::span<const Triangle> tria
                         }
                       }
                     });
-  result.pairs = sorted_union(found);
-  return result;
+  return sorted_union(found);
 }
 
 Pairs TriangleCells::crossing_pairs() const {

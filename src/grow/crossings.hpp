@@ -49,13 +49,9 @@ inline Box box_of(std::span<const Vec3f> points, const Triangle& t) {
   return enclose(enclose(corner, points[t[1]]), points[t[2]]);
 }
 
-// The crossing pairs among the triangles of a run, and the triangles no search covers.
-struct RunCrossings {
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;  // (s, t), s < t, sorted
-  std::vector<std::uint32_t> without_ball;  // no circumball (corners on a line within ~0.006°)
-};
-
-// Every pair of triangles with a circumball that cross (triangles_cross), found by this fact:
+// Every pair (s, t), s < t, sorted, of triangles with a circumball that cross
+// (triangles_cross); a triangle without one (has_circumball: a sliver under ~0.006°, which the
+// grower never makes) is not searched. Found by this fact:
 // two triangles, each with the corners it does not share with the other outside the other's
 // padded circumball (padded_circumball), never cross. The difference of a point's powers with
 // respect to the two spheres is an affine function, positive at one triangle's other corners
@@ -67,7 +63,8 @@ struct RunCrossings {
 // Inputs: grid (its points are the corners), triangles. Cost: one ball query per triangle (the
 // vertices found in the balls of uncertified ones are kept, and only their stars are built);
 // the pairs are the same for any thread count.
-RunCrossings find_crossings(const HashGrid& grid, std::span<const Triangle> triangles);
+std::vector<std::pair<std::uint32_t, std::uint32_t>> find_crossings(
+    const HashGrid& grid, std::span<const Triangle> triangles);
 
 // Whether triangles a and b, with their padded circumballs (padded_circumball; radius2 < 0 for
 // none), each have the corners the other lacks outside the other's ball: then they cannot cross

@@ -339,15 +339,11 @@ class Grower {
   }
 
   // Of every pair of crossing triangles, the one grown later is marked dead (fronts that met
-  // between the layers of a noisy scan), and so is every triangle without a circumball (a
-  // sliver no search covers; its hole is filled like any other). Triangles loaded before the
-  // run are never removed. Corners of removed triangles become suspects of the non-manifold
-  // pass.
+  // between the layers of a noisy scan). Triangles loaded before the run are never removed.
+  // Corners of removed triangles become suspects of the non-manifold pass.
   std::vector<std::uint8_t> remove_crossings() {
     std::vector<std::uint8_t> dead(triangles_.size(), 0);
-    const detail::RunCrossings crossings = detail::find_crossings(grid_, triangles_);
-    for (const std::uint32_t t : crossings.without_ball) dead[t] = t >= preloaded_;
-    for (const auto& [first, second] : crossings.pairs) {
+    for (const auto& [first, second] : detail::find_crossings(grid_, triangles_)) {
       if (dead[first] || dead[second]) continue;
       if (second >= preloaded_) {
         dead[second] = 1;
@@ -847,9 +843,11 @@ class Grower {
       if ((on_pb & EdgeMap::kClosed) || on_pb == e.triangle) return false;
       if (on_pb == on_ap) return false;
     }
+    // No sliver: every triangle the grower makes has a circumball, so the crossing search
+    // (detail::find_crossings) covers them all.
     const Vec3 a = grid_.position(e.a), b = grid_.position(e.b);
+    if (!has_circumball(a, b, grid_.position(p))) return false;
     const Vec3 n_new = normalized(cross(a - b, grid_.position(p) - b));
-    if (norm2(n_new) == 0) return false;
     // A neighbour sharing the edge in the same direction will face the other way once the
     // groups are joined: compare with its normal reversed.
     if (on_ap != EdgeMap::kMissing) {

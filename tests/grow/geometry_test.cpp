@@ -35,6 +35,24 @@ void expect_smallest_ball(const Vec3& a, const Vec3& b, const Vec3& c, const Bal
   EXPECT_NEAR(dot(ball.centre - a, n), 0.0, 1e-12 * std::sqrt(scale));
 }
 
+TEST(Circumball, HasCircumballAgreesWithCircumball) {
+  // Random triangles, some of them slivers down to a flattening of 1e-9: the quick test and the
+  // full computation always agree.
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> where(-1, 1);
+  int slivers = 0;
+  for (int k = 0; k < 20000; ++k) {
+    const Vec3 a{where(rng), where(rng), where(rng)}, b{where(rng), where(rng), where(rng)};
+    const double flat = std::pow(10.0, -static_cast<double>(k % 10));
+    const Vec3 c = a + (b - a) * where(rng) + Vec3{where(rng), where(rng), where(rng)} * flat;
+    Ball ball;
+    const bool has = g2s::circumball(a, b, c, ball);
+    EXPECT_EQ(g2s::has_circumball(a, b, c), has);
+    slivers += !has;
+  }
+  EXPECT_GT(slivers, 1000);
+}
+
 TEST(Circumball, RightTriangleCentreIsTheHypotenuseMidpoint) {
   const Vec3 a{0, 0, 0}, b{2, 0, 0}, c{0, 2, 0};
   Ball ball;
