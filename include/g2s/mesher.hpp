@@ -35,6 +35,13 @@ struct MeshOptions {
   // kMaxHoleEdges counts (a loop of n edges costs O(n^3) memory and O(n^4) time to fill).
   int max_hole_edges = 30;
   static constexpr int kMaxHoleEdges = 100;
+  // A hole that cannot be filled over its own points (most often because the surface around it
+  // folds over it) may be widened by up to this many rings of triangles around it and filled in
+  // their place, leaving out the points inside that lie within 3 spacings of the surface
+  // (docs/algorithm.md, "Hole filling"); 0: every hole is filled over its own loop or not at all,
+  // and no point is left out. At most kMaxHoleRings.
+  int max_hole_rings = 3;
+  static constexpr int kMaxHoleRings = 10;
   // Orient each closed component outward (open, mostly horizontal ones up; see
   // docs/algorithm.md §6).
   bool orient = true;

@@ -11,7 +11,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
+#include <numeric>
 #include <optional>
 #include <span>
 
@@ -46,6 +48,14 @@ struct Candidate {
 
 bool traverses(const Triangle& t, Index u, Index v) {
   return (t[0] == u && t[1] == v) || (t[1] == u && t[2] == v) || (t[2] == u && t[0] == v);
+}
+
+std::pair<Index, Index> ordered(Index u, Index v) {
+  return {std::min(u, v), std::max(u, v)};
+}
+
+std::uint64_t edge_key(Index u, Index v) {
+  return std::uint64_t{std::min(u, v)} << 32 | std::max(u, v);
 }
 
 Index apex(const Triangle& t, Index u, Index v) {
@@ -99,13 +109,24 @@ class Grower {
     }
     if (options_.close_gaps) close_three_edge_gaps();
     finish_surface();
-    result.group.resize(triangles_.size());
-    result.flip.resize(triangles_.size());
+    // Groups in the layout of the context: every preloaded triangle (those a filling replaced
+    // too), then the new ones.
+    const std::size_t loaded = context.preload.size(), added = triangles_.size() - preloaded_;
+    result.group.resize(loaded + added);
+    result.flip.resize(loaded + added);
+    const auto record = [&](std::size_t at, std::uint32_t group, std::uint8_t flip) {
+      const auto [root, parity] = groups_.find(group);
+      result.group[at] = root;
+      result.flip[at] = parity ^ flip;
+    };
     for (std::size_t t = 0; t < triangles_.size(); ++t) {
-      const auto [root, parity] = groups_.find(group_[t]);
-      result.group[t] = root;
-      result.flip[t] = parity ^ flip_[t];
+      record(t < preloaded_ ? preload_index_[t] : loaded + (t - preloaded_), group_[t], flip_[t]);
     }
+    for (const RemovedPreload& r : removed_preload_) {
+      record(r.index, r.group, r.flip);
+      result.removed_preload.push_back(r.index);
+    }
+    std::sort(result.removed_preload.begin(), result.removed_preload.end());
     triangles_.erase(triangles_.begin(), triangles_.begin() + static_cast<long>(preloaded_));
     result.triangles = std::move(triangles_);
     result.second_fans = std::move(second_fans_);
@@ -141,6 +162,8 @@ class Grower {
       add_triangle(t[0], t[1], t[2], group, 0, false);
     }
     preloaded_ = preload.size();
+    preload_index_.resize(preloaded_);
+    std::iota(preload_index_.begin(), preload_index_.end(), 0u);
     auto group_of = [&](std::uint32_t label) {
       const auto at =
           std::lower_bound(label_group.begin(), label_group.end(), std::pair{label, 0u});
@@ -308,22 +331,31 @@ class Grower {
     fill_small_holes();
   }
 
-  // Removes the triangles marked dead (never one loaded before the run), and their edges from
-  // the Point-Edge Map. After growth the map is only asked whether an edge has none, one or two
-  // triangles, so the triangle numbers it holds are left as they were.
+  // Removes the triangles marked dead, and their edges from the Point-Edge Map (a triangle marked
+  // kUnlinked is off the map already). A triangle loaded before the run goes only as part of a
+  // widened hole's ring (kUnlinked); the result lists it. After growth the map is only asked
+  // whether an edge has none, one or two triangles, so the triangle numbers it holds are left as
+  // they were.
   void compact(std::vector<std::uint8_t> dead) {
-    std::size_t kept = 0;
+    std::size_t kept = 0, kept_loaded = 0;
     for (std::size_t t = 0; t < triangles_.size(); ++t) {
-      if (dead[t] && t >= preloaded_) {
+      const bool loaded = t < preloaded_;
+      if (dead[t] && (!loaded || dead[t] == kUnlinked)) {
         const Triangle& tri = triangles_[t];
-        for (int k = 0; k < 3; ++k) edges_.remove(tri[k], tri[(k + 1) % 3]);
+        if (dead[t] != kUnlinked) {
+          for (int k = 0; k < 3; ++k) edges_.remove(tri[k], tri[(k + 1) % 3]);
+        }
+        if (loaded) removed_preload_.push_back({preload_index_[t], group_[t], flip_[t]});
         continue;
       }
+      if (loaded) preload_index_[kept_loaded++] = preload_index_[t];
       triangles_[kept] = triangles_[t];
       group_[kept] = group_[t];
       flip_[kept] = flip_[t];
       ++kept;
     }
+    preloaded_ = kept_loaded;
+    preload_index_.resize(kept_loaded);
     triangles_.resize(kept);
     group_.resize(kept);
     flip_.resize(kept);
@@ -332,8 +364,9 @@ class Grower {
   // One round of hole filling (fill_holes) and the removal of fillings that cross each other.
   void fill_small_holes() {
     const auto grown = static_cast<std::uint32_t>(triangles_.size());
-    fill_holes();
-    std::vector<std::uint8_t> dead(triangles_.size(), 0);
+    std::vector<std::uint8_t> dead(grown, 0);
+    fill_holes(dead);
+    dead.resize(triangles_.size(), 0);
     remove_crossing_fills(grown, dead);
     compact(std::move(dead));
   }
@@ -372,8 +405,11 @@ class Grower {
   // at a point with several fans each edge in goes on by the first free edge out
   // counter-clockwise from it (next_open_edges), so the gap between two fans is a hole of its
   // own, and filling it makes the two fans one; a loop through a point twice is split there.
-  // Appends the filling triangles to triangles_.
-  void fill_holes() {
+  // A hole that cannot be filled so (most often because the surface around it folds over it) is
+  // widened ring by ring (widen) and filled in place of the rings, if it then can be and the
+  // points that leaves out lie close to the surface (leaves_out_only_near). Appends the filling
+  // triangles to triangles_ and marks the rings kUnlinked in `dead` (sized as triangles_).
+  void fill_holes(std::vector<std::uint8_t>& dead) {
     // The grown triangles filed for the crossing test, once a loop needs them. The fillings wait
     // in `filled` until every loop is done, so that the filed triangles stay where they are.
     std::optional<detail::TriangleCells> cells;
@@ -396,6 +432,7 @@ class Grower {
     const std::vector<std::uint32_t> next = next_open_edges(open);
     const auto max_edges =
         static_cast<std::size_t>(std::min(options_.max_hole_edges, MeshOptions::kMaxHoleEdges));
+    const int max_rings = std::clamp(options_.max_hole_rings, 0, MeshOptions::kMaxHoleRings);
     // The loops first, as runs of open edges (loop_edges[begin, begin + length)), each with its
     // component (the surface piece it borders) and whether it can be filled (every point
     // fillable, the loop closed). A loop that passes a point twice is split there into loops
@@ -448,66 +485,72 @@ class Grower {
     // into a shell.
     std::vector<std::uint32_t> longest(grid_.size(), 0);
     for (const Loop& l : loops) longest[l.component] = std::max(longest[l.component], l.length);
-    std::vector<Index> loop;
-    std::vector<Vec3> around;
+    // Which loops are holes, and where each open edge is, for holes that widen into others.
+    HoleIndex holes{open, loop_edges, {}, {}, {}, {}, {}};
+    holes.loop_of.resize(open.size());
+    for (std::uint32_t i = 0; i < loops.size(); ++i) {
+      const Loop& l = loops[i];
+      holes.loop_begin.push_back(l.begin);
+      holes.is_hole.push_back(l.closable && l.length >= 3 && l.length != longest[l.component]);
+      for (std::uint32_t k = l.begin; k < l.begin + l.length; ++k) holes.loop_of[loop_edges[k]] = i;
+    }
+    holes.loop_begin.push_back(static_cast<std::uint32_t>(loop_edges.size()));
+    holes.taken.assign(loops.size(), 0);
+    holes.by_edge.reserve(open.size());
+    for (std::uint32_t h = 0; h < open.size(); ++h) {
+      holes.by_edge.push_back({edge_key(open[h].from, open[h].to), h});
+    }
+    std::sort(holes.by_edge.begin(), holes.by_edge.end());
+    Attempt attempt;
     std::vector<Triangle> fill;
     detail::HoleScratch scratch;
-    for (const Loop& l : loops) {
-      if (!l.closable || l.length < 3 || l.length > max_edges) continue;
-      if (l.length == longest[l.component]) continue;
-      const std::span<const std::uint32_t> edges(loop_edges.data() + l.begin, l.length);
-      loop.clear();
-      around.clear();
-      for (const std::uint32_t e : edges) {
-        loop.push_back(open[e].from);
-        around.push_back(facing_normal(open[e].triangle));
-      }
-      // The filling traverses each loop edge the other way: the loop reversed, so that edge i
-      // of the reversed loop is edge n-2-i of the loop, and the closing edge stays last.
-      std::reverse(loop.begin(), loop.end());
-      std::reverse(around.begin(), around.end() - 1);
-      fill.clear();
-      const auto chord_ok = [&](std::size_t i, std::size_t j) {
-        return edges_.find(loop[i], loop[j]) == EdgeMap::kMissing;
-      };
-      if (!cells) cells.emplace(grid_.points(), std::span<const Triangle>(triangles_));
-      // Every filling triangle lies in the loop's box: the grown triangles that may cross one
-      // are those whose boxes overlap it, found once per loop.
-      detail::Box loop_box{grid_.point(loop[0]), grid_.point(loop[0])};
-      for (const Index v : loop) loop_box = detail::enclose(loop_box, grid_.point(v));
-      loop_near_.clear();
-      cells->for_each_near(
-          loop_box.lo, loop_box.hi, [&](std::uint32_t other, const detail::Box& box) {
-            const Triangle& o = triangles_[other];
-            NearTriangle near{other, box, {}};
-            if (!detail::padded_circumball(grid_.position(o[0]), grid_.position(o[1]),
-                                           grid_.position(o[2]), near.ball)) {
-              if (detail::degenerate(grid_.points(), o)) return;  // crosses none
-              near.ball.radius2 = -1;
-            }
-            loop_near_.push_back(near);
-          });
-      const auto triangle_ok = [&](std::size_t i, std::size_t k, std::size_t j) {
-        return fill_fits({loop[i], loop[k], loop[j]});
-      };
-      if (!detail::triangulate_loop(grid_.points(), loop, around, chord_ok, triangle_ok, scratch,
-                                    fill)) {
+    for (std::uint32_t i = 0; i < loops.size(); ++i) {
+      const Loop& l = loops[i];
+      if (!holes.is_hole[i] || holes.taken[i] || l.length > max_edges) continue;
+      const std::span<const std::uint32_t> edges = holes.edges_of(i);
+      // A ring taken by an earlier loop's filling may have reached this loop.
+      if (std::any_of(edges.begin(), edges.end(),
+                      [&](std::uint32_t e) { return dead[open[e].triangle] != 0; })) {
         continue;
       }
+      attempt.clear();
+      attempt.merged.push_back(i);
+      for (const std::uint32_t e : edges) {
+        attempt.add_edge(open[e].from, open[e].triangle, facing_normal(open[e].triangle));
+      }
+      if (!cells) cells.emplace(grid_.points(), std::span<const Triangle>(triangles_));
+      bool done = try_fill(*cells, attempt, scratch, fill);
+      for (int round = 0; !done && round < max_rings; ++round) {
+        if (!widen(*cells, attempt, holes, dead, max_edges)) break;
+        done =
+            try_fill(*cells, attempt, scratch, fill) && leaves_out_only_near(attempt, fill, dead);
+      }
+      if (!done) continue;
+      for (const std::uint32_t m : attempt.merged) holes.taken[m] = 1;
       // The triangles around face consistently along the loop: their groups become one, as
       // they face now.
-      const std::uint32_t group = group_[open[edges.front()].triangle];
-      for (const std::uint32_t e : edges) {
-        groups_.unite(groups_.find(group).first, groups_.find(group_[open[e].triangle]).first, 0);
+      const std::uint32_t group = group_[attempt.outside.front()];
+      for (const std::uint32_t t : attempt.outside) {
+        groups_.unite(groups_.find(group).first, groups_.find(group_[t]).first, 0);
       }
       const std::uint8_t flip = groups_.find(group).second;
+      for (const std::uint32_t r : attempt.ring) {
+        dead[r] = kUnlinked;
+        const Triangle& tri = triangles_[r];
+        for (int k = 0; k < 3; ++k) edges_.remove(tri[k], tri[(k + 1) % 3]);
+        second_fans_.insert(second_fans_.end(), tri.begin(), tri.end());
+      }
       const auto first = static_cast<std::uint32_t>(grown + filled.size());
+      fill_records_.push_back({first, static_cast<std::uint32_t>(fill.size()),
+                               static_cast<std::uint32_t>(fill_rings_.size()),
+                               static_cast<std::uint32_t>(attempt.ring.size())});
+      fill_rings_.insert(fill_rings_.end(), attempt.ring.begin(), attempt.ring.end());
       for (const Triangle& t : fill) {
         const auto id = static_cast<std::uint32_t>(grown + filled.size());
         filled.push_back(t);
         group_.push_back(group);
         flip_.push_back(flip);
-        fill_loop_.push_back(first);
+        fill_loop_.push_back(static_cast<std::uint32_t>(fill_records_.size() - 1));
         for (int k = 0; k < 3; ++k) edges_.add(t[k], t[(k + 1) % 3], id);
       }
     }
@@ -519,6 +562,249 @@ class Grower {
     Index from, to;
     std::uint32_t triangle;
   };
+
+  // One hole's filling: its triangles (from `first`) and the ring of triangles it replaced
+  // (fill_rings_[ring_begin, ring_begin + ring_size)).
+  struct FillRecord {
+    std::uint32_t first, count, ring_begin, ring_size;
+  };
+
+  // One round's loops of open edges: each loop's run in loop_edges, whether it is a hole that
+  // may be filled (closed, every point fillable, not its piece's outer border) and whether a
+  // filling took it; per open edge its loop, and the open edges by key (edge_key).
+  struct HoleIndex {
+    std::span<const OpenEdge> open;
+    std::span<const std::uint32_t> loop_edges;
+    std::vector<std::uint32_t> loop_begin;  // one more than loops: the end
+    std::vector<std::uint8_t> is_hole, taken;
+    std::vector<std::uint32_t> loop_of;
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> by_edge;  // sorted
+
+    std::span<const std::uint32_t> edges_of(std::uint32_t loop) const {
+      return loop_edges.subspan(loop_begin[loop], loop_begin[loop + 1] - loop_begin[loop]);
+    }
+    // The open edge on {u, v}, or kNoIndex.
+    std::uint32_t find(Index u, Index v) const {
+      const std::uint64_t key = edge_key(u, v);
+      const auto it = std::lower_bound(by_edge.begin(), by_edge.end(),
+                                       std::pair<std::uint64_t, std::uint32_t>{key, 0});
+      return it != by_edge.end() && it->first == key ? it->second : kNoIndex;
+    }
+  };
+
+  // A hole to fill: its loop as the open edges around it run (loop[i] -> loop[i+1]), with the
+  // triangle outside each edge and that triangle's facing normal; the ring of triangles that
+  // the filling replaces (none at first), and the edges inside the hole and ring, which the
+  // filling may use again once the ring is gone.
+  struct Attempt {
+    std::vector<Index> loop;
+    std::vector<std::uint32_t> outside;
+    std::vector<Vec3> around;
+    std::vector<std::uint32_t> ring;                   // sorted
+    std::vector<std::pair<Index, Index>> inner_edges;  // sorted, (smaller, larger)
+    std::vector<std::uint32_t> merged;                 // the holes it fills (HoleIndex loops)
+
+    void clear() {
+      merged.clear();
+      loop.clear();
+      outside.clear();
+      around.clear();
+      ring.clear();
+      inner_edges.clear();
+    }
+    void add_edge(Index from, std::uint32_t triangle, const Vec3& normal) {
+      loop.push_back(from);
+      outside.push_back(triangle);
+      around.push_back(normal);
+    }
+    bool in_ring(std::uint32_t t) const { return std::binary_search(ring.begin(), ring.end(), t); }
+  };
+
+  // Whether every point a widened hole's filling leaves out (a corner of its ring that is not on
+  // its loop) lies within two spacings of the filling or of a live triangle near the loop
+  // (loop_near_): a hole is closed by leaving out only points close to the surface.
+  bool leaves_out_only_near(const Attempt& attempt, std::span<const Triangle> fill,
+                            const std::vector<std::uint8_t>& dead) const {
+    const double limit = kMaxLeftOutDistance * grid_.spacing(), limit2 = limit * limit;
+    for (const std::uint32_t r : attempt.ring) {
+      for (const Index v : triangles_[r]) {
+        if (std::find(attempt.loop.begin(), attempt.loop.end(), v) != attempt.loop.end()) continue;
+        const Vec3 p = grid_.position(v);
+        double nearest2 = std::numeric_limits<double>::infinity();
+        for (const Triangle& t : fill) {
+          const Vec3 q = closest_on_triangle(p, grid_.position(t[0]), grid_.position(t[1]),
+                                             grid_.position(t[2]));
+          nearest2 = std::min(nearest2, norm2(p - q));
+        }
+        for (const NearTriangle& near : loop_near_) {
+          if (nearest2 <= limit2) break;
+          if (dead[near.index]) continue;
+          const Triangle& t = triangles_[near.index];
+          const Vec3 q = closest_on_triangle(p, grid_.position(t[0]), grid_.position(t[1]),
+                                             grid_.position(t[2]));
+          nearest2 = std::min(nearest2, norm2(p - q));
+        }
+        if (nearest2 > limit2) return false;
+      }
+    }
+    return true;
+  }
+
+  // Triangulates the attempt's loop (triangulate_loop) into `fill`, if it can be.
+  bool try_fill(const detail::TriangleCells& cells, const Attempt& attempt,
+                detail::HoleScratch& scratch, std::vector<Triangle>& fill) {
+    // The filling traverses each loop edge the other way: the loop reversed, so that edge i
+    // of the reversed loop is edge n-2-i of the loop, and the closing edge stays last.
+    loop_.assign(attempt.loop.rbegin(), attempt.loop.rend());
+    around_.assign(attempt.around.begin(), attempt.around.end());
+    std::reverse(around_.begin(), around_.end() - 1);
+    fill.clear();
+    const auto chord_ok = [&](std::size_t i, std::size_t j) {
+      const Index u = loop_[i], v = loop_[j];
+      return edges_.find(u, v) == EdgeMap::kMissing ||
+             std::binary_search(attempt.inner_edges.begin(), attempt.inner_edges.end(),
+                                ordered(u, v));
+    };
+    // Every filling triangle lies in the loop's box: the grown triangles that may cross one
+    // are those whose boxes overlap it, found once per loop. Rings taken by other fillings
+    // stay among them, so that a filling taken off again can give its ring back.
+    detail::Box loop_box{grid_.point(loop_[0]), grid_.point(loop_[0])};
+    for (const Index v : loop_) loop_box = detail::enclose(loop_box, grid_.point(v));
+    loop_near_.clear();
+    cells.for_each_near(loop_box.lo, loop_box.hi, [&](std::uint32_t other, const detail::Box& box) {
+      if (attempt.in_ring(other)) return;
+      const Triangle& o = triangles_[other];
+      NearTriangle near{other, box, {}};
+      if (!detail::padded_circumball(grid_.position(o[0]), grid_.position(o[1]),
+                                     grid_.position(o[2]), near.ball)) {
+        if (detail::degenerate(grid_.points(), o)) return;  // crosses none
+        near.ball.radius2 = -1;
+      }
+      loop_near_.push_back(near);
+    });
+    const auto triangle_ok = [&](std::size_t i, std::size_t k, std::size_t j) {
+      return fill_fits({loop_[i], loop_[k], loop_[j]});
+    };
+    return detail::triangulate_loop(grid_.points(), loop_, around_, chord_ok, triangle_ok, scratch,
+                                    fill)
+        .has_value();
+  }
+
+  // Widens a hole that could not be filled by the ring of triangles around it: the triangles
+  // outside its loop join the ring, holes the ring reaches join the hole, and the loop becomes
+  // the border of them all. Where that border would pass a point twice, the point's whole fan
+  // joins the ring too. Gives up (false, attempt unusable) where the ring would take a triangle
+  // at a point that is not fillable, would reach a piece's outer border or a hole already filled,
+  // or where the border would have more than max_edges edges.
+  bool widen(const detail::TriangleCells& cells, Attempt& attempt, const HoleIndex& holes,
+             const std::vector<std::uint8_t>& dead, std::size_t max_edges) {
+    std::vector<std::uint32_t>& ring = attempt.ring;
+    ring.insert(ring.end(), attempt.outside.begin(), attempt.outside.end());
+    const std::size_t merged_before = attempt.merged.size();
+    std::vector<Border>& border = border_;
+    for (int pass = 0;; ++pass) {
+      std::sort(ring.begin(), ring.end());
+      ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
+      attempt.merged.resize(merged_before);
+      if (!trace_border(attempt, holes, dead, max_edges)) return false;
+      // Points the border passes twice: their fans join the ring.
+      std::sort(border.begin(), border.end(),
+                [](const Border& a, const Border& b) { return a.from < b.from; });
+      pinched_.clear();
+      for (std::size_t k = 1; k < border.size(); ++k) {
+        if (border[k].from == border[k - 1].from) pinched_.push_back(border[k].from);
+      }
+      if (pinched_.empty()) break;
+      if (pass == kMaxPinchPasses) return false;
+      for (const Index v : pinched_) {
+        const Vec3f& p = grid_.point(v);
+        cells.for_each_near(p, p, [&](std::uint32_t t, const detail::Box&) {
+          const Triangle& tri = triangles_[t];
+          if (!dead[t] && std::find(tri.begin(), tri.end(), v) != tri.end()) ring.push_back(t);
+        });
+      }
+    }
+    // The triangles outside the ring's border edges, among those near it.
+    detail::Box box{grid_.point(border[0].from), grid_.point(border[0].from)};
+    for (const Border& e : border) box = detail::enclose(box, grid_.point(e.from));
+    cells.for_each_near(box.lo, box.hi, [&](std::uint32_t t, const detail::Box&) {
+      if (dead[t] || attempt.in_ring(t)) return;
+      const Triangle& tri = triangles_[t];
+      for (Border& e : border) {
+        if (e.outside == kNoIndex && std::find(tri.begin(), tri.end(), e.from) != tri.end() &&
+            std::find(tri.begin(), tri.end(), e.to) != tri.end()) {
+          e.outside = t;
+        }
+      }
+    });
+    // Chain the border edges (sorted by `from`, each point once) into one loop.
+    const auto leaving = [&](Index v) {
+      const auto it = std::lower_bound(border.begin(), border.end(), v,
+                                       [](const Border& e, Index from) { return e.from < from; });
+      return it != border.end() && it->from == v ? static_cast<std::size_t>(it - border.begin())
+                                                 : border.size();
+    };
+    attempt.loop.clear();
+    attempt.outside.clear();
+    attempt.around.clear();
+    std::size_t k = 0;
+    do {
+      const Border& e = border[k];
+      if (e.outside == kNoIndex) return false;
+      attempt.add_edge(e.from, e.outside, facing_normal(e.outside));
+      k = leaving(e.to);
+      if (k == border.size() || attempt.loop.size() > border.size()) return false;
+    } while (k != 0);
+    return attempt.loop.size() == border.size();
+  }
+
+  // The border of the attempt's ring and holes (border_, unordered): ring edges with a triangle
+  // outside the ring, and the edges of holes the ring reaches, which join the attempt (merged).
+  // Also lists the edges inside (inner_edges). False where widen gives up.
+  bool trace_border(Attempt& attempt, const HoleIndex& holes, const std::vector<std::uint8_t>& dead,
+                    std::size_t max_edges) {
+    ring_edges_.clear();
+    for (const std::uint32_t r : attempt.ring) {
+      if (dead[r]) return false;
+      const Triangle tri = facing(r);
+      for (int k = 0; k < 3; ++k) {
+        if (!fillable(tri[k])) return false;
+        const Index u = tri[k], v = tri[(k + 1) % 3];
+        ring_edges_.push_back({edge_key(u, v), Border{v, u, kNoIndex}});
+      }
+    }
+    std::sort(ring_edges_.begin(), ring_edges_.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    border_.clear();
+    attempt.inner_edges.clear();
+    for (std::size_t a = 0, b = 0; a < ring_edges_.size(); a = b) {
+      while (b < ring_edges_.size() && ring_edges_[b].first == ring_edges_[a].first) ++b;
+      const Border& e = ring_edges_[a].second;
+      attempt.inner_edges.push_back(ordered(e.from, e.to));
+      if (b - a == 2) continue;
+      if (triangles_on(e.from, e.to) == 2) {
+        border_.push_back(e);
+        continue;
+      }
+      const std::uint32_t h = holes.find(e.from, e.to);
+      if (h == kNoIndex) return false;
+      const std::uint32_t hole = holes.loop_of[h];
+      if (std::find(attempt.merged.begin(), attempt.merged.end(), hole) != attempt.merged.end()) {
+        continue;
+      }
+      if (!holes.is_hole[hole] || holes.taken[hole]) return false;
+      attempt.merged.push_back(hole);
+    }
+    for (std::size_t m = 1; m < attempt.merged.size(); ++m) {
+      for (const std::uint32_t h : holes.edges_of(attempt.merged[m])) {
+        const OpenEdge& e = holes.open[h];
+        if (dead[e.triangle]) return false;
+        if (!attempt.in_ring(e.triangle)) border_.push_back({e.from, e.to, e.triangle});
+      }
+    }
+    std::sort(attempt.inner_edges.begin(), attempt.inner_edges.end());
+    return border_.size() >= 3 && border_.size() <= max_edges;
+  }
 
   // Per open edge, the open edge its hole's loop goes on by: out of the point it leads to, the
   // first edge counter-clockwise (about the fans' mean normal) from the direction back along
@@ -636,22 +922,57 @@ class Grower {
   }
 
   // Fillings of neighbouring holes may cross each other: the later filling of each crossing
-  // pair goes whole (its hole opens again as it was). Fillings start at triangle `first_fill`;
-  // fill_loop_ gives each the first triangle of its filling.
+  // pair goes whole, and its hole opens again as it was (its ring back, where no filling has
+  // taken an edge of it since). Fillings start at triangle `first_fill`.
   void remove_crossing_fills(std::uint32_t first_fill, std::vector<std::uint8_t>& dead) {
-    if (triangles_.size() == first_fill) return;
-    const std::span<const Triangle> fills =
-        std::span<const Triangle>(triangles_).subspan(first_fill);
-    const auto pairs = detail::TriangleCells(grid_.points(), fills).crossing_pairs();
-    for (const auto& [first, second] : pairs) {
-      const std::uint32_t earlier = fill_loop_[first], later = fill_loop_[second];
-      if (dead[earlier]) continue;
-      for (std::uint32_t t = later; t < triangles_.size() && fill_loop_[t - first_fill] == later;
-           ++t) {
-        dead[t] = 1;
+    if (triangles_.size() > first_fill) {
+      const std::span<const Triangle> fills =
+          std::span<const Triangle>(triangles_).subspan(first_fill);
+      const auto pairs = detail::TriangleCells(grid_.points(), fills).crossing_pairs();
+      for (const auto& [first, second] : pairs) {
+        const FillRecord& earlier = fill_records_[fill_loop_[first]];
+        const FillRecord& later = fill_records_[fill_loop_[second]];
+        if (dead[earlier.first] || dead[later.first]) continue;
+        unfill(later, dead);
       }
     }
     fill_loop_.clear();
+    fill_records_.clear();
+    fill_rings_.clear();
+  }
+
+  // Takes a filling off the mesh and puts its ring back if every edge of the ring still has room.
+  void unfill(const FillRecord& record, std::vector<std::uint8_t>& dead) {
+    for (std::uint32_t t = record.first; t < record.first + record.count; ++t) {
+      dead[t] = kUnlinked;
+      const Triangle& tri = triangles_[t];
+      for (int k = 0; k < 3; ++k) edges_.remove(tri[k], tri[(k + 1) % 3]);
+    }
+    const std::span<const std::uint32_t> ring(fill_rings_.data() + record.ring_begin,
+                                              record.ring_size);
+    std::vector<std::pair<Index, Index>> ring_edges;
+    for (const std::uint32_t r : ring) {
+      const Triangle& tri = triangles_[r];
+      for (int k = 0; k < 3; ++k) {
+        ring_edges.push_back(ordered(tri[k], tri[(k + 1) % 3]));
+      }
+    }
+    std::sort(ring_edges.begin(), ring_edges.end());
+    for (std::size_t a = 0, b = 0; a < ring_edges.size(); a = b) {
+      while (b < ring_edges.size() && ring_edges[b] == ring_edges[a]) ++b;
+      if (triangles_on(ring_edges[a].first, ring_edges[a].second) + (b - a) > 2) return;
+    }
+    for (const std::uint32_t r : ring) {
+      dead[r] = 0;
+      const Triangle& tri = triangles_[r];
+      for (int k = 0; k < 3; ++k) edges_.add(tri[k], tri[(k + 1) % 3], r);
+    }
+  }
+
+  // How many triangles edge {u, v} has: 0, 1 or 2.
+  int triangles_on(Index u, Index v) const {
+    const std::uint32_t value = edges_.find(u, v);
+    return value == EdgeMap::kMissing ? 0 : (value & EdgeMap::kClosed) ? 2 : 1;
   }
 
   // Processes front edges until the front is empty (docs/algorithm.md §4).
@@ -929,7 +1250,14 @@ class Grower {
   const int levels_;
   const int flat_levels_;
   std::vector<Triangle> triangles_;  // the preloaded ones first
-  std::size_t preloaded_ = 0;
+  std::size_t preloaded_ = 0;        // triangles_[0, preloaded_) were loaded before the run
+  std::vector<std::uint32_t> preload_index_;  // per loaded triangle: its place in the context
+  // Loaded triangles a filling replaced, with their groups as they were.
+  struct RemovedPreload {
+    std::uint32_t index, group;
+    std::uint8_t flip;
+  };
+  std::vector<RemovedPreload> removed_preload_;
   std::vector<std::uint32_t> group_;  // per triangle: its orientation group
   std::vector<std::uint8_t> flip_;    // per triangle: its parity within the group
   ParityUnionFind groups_;
@@ -939,9 +1267,19 @@ class Grower {
   // Per point: kUsed once it is a corner, plus the number of open edges at it; one array, so
   // that the interior test of every point a search ball holds is a single load.
   static constexpr std::uint32_t kUsed = 0x80000000u;
+  // Marks for compact: removed with its edges, or off the Point-Edge Map already.
+  static constexpr std::uint8_t kRemove = 1, kUnlinked = 2;
+  // How many times a widened border that passes a point twice may take in that point's fan.
+  static constexpr int kMaxPinchPasses = 3;
+  // How far (in spacings) from the surface a point that a widened filling leaves out may lie:
+  // noise spreads a scan's points over a layer a few spacings thick, and the points further out
+  // stay vertices.
+  static constexpr double kMaxLeftOutDistance = 3;
   std::vector<std::uint32_t> state_;
-  std::vector<FrontEdge> stalled_;        // edges that left the queue without a triangle (stall())
-  std::vector<std::uint32_t> fill_loop_;  // per filling triangle: the first of its filling
+  std::vector<FrontEdge> stalled_;  // edges that left the queue without a triangle (stall())
+  std::vector<FillRecord> fill_records_;
+  std::vector<std::uint32_t> fill_rings_;
+  std::vector<std::uint32_t> fill_loop_;  // per filling triangle: its FillRecord
   std::uint64_t used_count_ = 0;
   BucketQueue<FrontEdge> queue_;
   const int last_priority_;
@@ -963,6 +1301,16 @@ class Grower {
     Ball ball;
   };
   std::vector<NearTriangle> loop_near_;
+  // An edge of a widened hole's border, as the triangle outside it faces (outside, once found).
+  struct Border {
+    Index from, to;
+    std::uint32_t outside;
+  };
+  std::vector<Border> border_;  // widen's scratch
+  std::vector<std::pair<std::uint64_t, Border>> ring_edges_;
+  std::vector<Index> pinched_;
+  std::vector<Index> loop_;  // try_fill's loop and normals
+  std::vector<Vec3> around_;
 };
 
 }  // namespace

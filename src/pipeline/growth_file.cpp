@@ -61,6 +61,7 @@ std::uint64_t options_fingerprint(const PipelineOptions& options) {
   put(mesh.seed_ball);
   put(static_cast<std::uint64_t>(mesh.close_gaps) | static_cast<std::uint64_t>(mesh.orient) << 1);
   put(static_cast<std::uint64_t>(mesh.max_hole_edges));
+  put(static_cast<std::uint64_t>(mesh.max_hole_rings));
   put(options.halo_spacings);
   put(options.band_spacings);
   put(static_cast<std::uint64_t>(options.stitch_retries));

@@ -107,6 +107,25 @@ struct LiveMesh {
     for (Index s : slots) ++uses[s];
   }
 
+  // Takes the triangles at the sorted places `at` off, in place.
+  void remove_triangles(const std::vector<std::uint32_t>& at) {
+    std::size_t kept = 0, next = 0;
+    for (std::size_t t = 0; t < triangles.size(); ++t) {
+      if (next < at.size() && at[next] == t) {
+        ++next;
+        for (Index s : triangles[t]) --uses[s];
+        continue;
+      }
+      triangles[kept] = triangles[t];
+      group[kept] = group[t];
+      due[kept] = due[t];
+      ++kept;
+    }
+    triangles.resize(kept);
+    group.resize(kept);
+    due.resize(kept);
+  }
+
   // Forgets a released point no live triangle uses.
   void free_slot(std::uint32_t s) {
     if (!(flags[s] & kUnlisted)) slot_of.erase(id[s]);

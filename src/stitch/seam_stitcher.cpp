@@ -93,6 +93,7 @@ class SeamStitcher {
     // the grower starts from what earlier seams already decided; in the order they were made.
     preload_.clear();
     preload_group_.clear();
+    preload_live_.clear();
     for (std::size_t t = 0; t < live.triangles.size(); ++t) {
       const Triangle& tri = live.triangles[t];
       if (!((live.flags[tri[0]] | live.flags[tri[1]] | live.flags[tri[2]]) & LiveMesh::kInBand)) {
@@ -103,6 +104,7 @@ class SeamStitcher {
       if (parity) std::swap(ids[1], ids[2]);
       preload_.push_back(ids);
       preload_group_.push_back(root);
+      preload_live_.push_back(static_cast<std::uint32_t>(t));
       for (Index s : tri) {
         take(live.id[s], (live.flags[s] & LiveMesh::kInBand) != 0, &live.xyz[3 * std::size_t{s}]);
       }
@@ -158,6 +160,12 @@ class SeamStitcher {
       }
       live.groups.unite(preload_group_[a], preload_group_[k],
                         static_cast<std::uint8_t>(grown.flip[k] ^ grown.flip[a]));
+    }
+    // Live triangles the grower took off to fill a widened hole (their groups still anchor).
+    if (!grown.removed_preload.empty()) {
+      std::vector<std::uint32_t> removed;
+      for (std::uint32_t k : grown.removed_preload) removed.push_back(preload_live_[k]);
+      live.remove_triangles(removed);
     }
     std::vector<std::uint32_t> fresh(group_ids.size(), kNoIndex);  // groups with no anchor
     std::uint64_t added = 0, dropped = 0;
@@ -277,6 +285,7 @@ class SeamStitcher {
   std::vector<std::uint8_t> growable_;
   std::vector<Triangle> preload_;
   std::vector<std::uint32_t> preload_group_;
+  std::vector<std::uint32_t> preload_live_;  // per preloaded triangle: its place in the live mesh
   // The orientation vote's scratch: per seam grid point, its label and normal.
   std::vector<std::uint32_t> label_;
   std::vector<Vec3> normal_;

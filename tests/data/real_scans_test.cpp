@@ -15,6 +15,7 @@
 #include "g2s/io.hpp"
 #include "g2s/pipeline.hpp"
 #include "g2s/stats.hpp"
+#include "support/clean_mesh.hpp"
 #include "support/cli.hpp"
 
 namespace {
@@ -58,13 +59,8 @@ TEST_P(RealScan, MeshIsManifoldOrientedAndMeetsItsBaseline) {
   RecordProperty("holes", std::to_string(s.holes));
   RecordProperty("coverage", std::to_string(s.coverage));
 
-  EXPECT_EQ(s.non_manifold_edges, 0u);
-  EXPECT_EQ(s.non_manifold_vertices, 0u);
-  EXPECT_EQ(s.orientation_conflicts, 0u);
-  EXPECT_EQ(s.duplicate_triangles, 0u);
-  EXPECT_EQ(s.degenerate_triangles, 0u);
-  // Exact count, as g2s stats makes it: the mesher leaves no crossing triangles.
-  EXPECT_EQ(s.crossing_pairs, 0u);
+  // Crossings counted exactly, as g2s stats counts them: the mesher leaves none.
+  g2s::test_support::expect_clean_mesh(s);
   if (b.closed) {
     EXPECT_GE(s.coverage, 0.995);
     EXPECT_GE(per_point, 1.9);
@@ -88,6 +84,7 @@ TEST(RealScanGaps, ClosingGapsLeavesFewerHolesAndNoDefect) {
       g2s::PipelineOptions options;
       options.mesh.close_gaps = close;
       if (!close) options.mesh.max_hole_edges = 0;  // hole filling closes such gaps too
+      options.mesh.max_hole_rings = 0;              // widened holes leave points out
       g2s::PipelineMesh mesh = g2s::mesh_cloud(cloud, options);
       s[close] = g2s::compute_stats({cloud.xyz, std::move(mesh.triangles)}, &cloud);
       EXPECT_EQ(s[close].non_manifold_edges, 0u);
@@ -105,21 +102,58 @@ TEST(RealScanGaps, ClosingGapsLeavesFewerHolesAndNoDefect) {
   }
 }
 
+// Widening the holes that cannot be filled over their own points (MeshOptions::max_hole_rings)
+// must leave fewer holes and no defect, and leave out only points close to the surface: the
+// grower allows 3 of the tile's spacings, and on a cloud of two densities (table-mug) a sparse
+// tile's spacing is larger than the cloud's, which the statistics use, so a few of them are
+// farther than 4 of those (measured: 97-100% within 4 on these scans).
+TEST(RealScanGaps, WideningHolesLeavesFewerHolesAndOnlyPointsNearTheSurfaceOut) {
+  for (const char* name :
+       {"raw-bunny", "open-table-mug-stereo", "open-lion-photogrammetry", "open-autzen-lidar"}) {
+    SCOPED_TRACE(name);
+    const std::filesystem::path path = data_dir() / (std::string(name) + ".ply");
+    G2S_SKIP_WITHOUT_DATA(path);
+    const g2s::PointCloud cloud = g2s::read_points(path);
+    g2s::MeshStats s[2];
+    for (const int rings : {0, g2s::MeshOptions{}.max_hole_rings}) {
+      g2s::PipelineOptions options;
+      options.mesh.max_hole_rings = rings;
+      g2s::PipelineMesh mesh = g2s::mesh_cloud(cloud, options);
+      g2s::MeshStats& m = s[rings > 0];
+      m = g2s::compute_stats({cloud.xyz, std::move(mesh.triangles)}, &cloud);
+      g2s::test_support::expect_clean_mesh(m);
+      ASSERT_TRUE(m.has_distances);
+    }
+    std::printf("%s: holes %llu -> %llu, points left out %llu -> %llu\n", name,
+                static_cast<unsigned long long>(s[0].holes),
+                static_cast<unsigned long long>(s[1].holes),
+                static_cast<unsigned long long>(s[0].off_mesh_points),
+                static_cast<unsigned long long>(s[1].off_mesh_points));
+    EXPECT_LT(static_cast<double>(s[1].holes), 0.95 * static_cast<double>(s[0].holes));
+    ASSERT_GE(s[1].off_mesh_points, s[0].off_mesh_points);
+    const auto more_left_out = static_cast<double>(s[1].off_mesh_points - s[0].off_mesh_points);
+    const auto more_within_4 =
+        static_cast<double>(s[1].off_mesh_within_4) - static_cast<double>(s[0].off_mesh_within_4);
+    EXPECT_GE(more_within_4, 0.9 * more_left_out);
+  }
+}
+
 // Baselines measured through mesh_cloud (the tiled path `g2s mesh` runs, default options and
 // memory budget) after the surface finishing step (no crossings, holes filled): boundary edges and
 // holes plus 5% (rounded up; one more hole where the count is tiny), coverage minus 0.002. Lower
 // them when the mesher improves. closed-bunny-zipper is closed now that the small holes the scan
-// leaves in its base are filled.
+// leaves in its base are filled. Widened holes (MeshOptions::max_hole_rings) leave out points
+// near the surface: the noisy scans' coverage fell by 0.1 to 0.7 points with them.
 INSTANTIATE_TEST_SUITE_P(
     SharedData, RealScan,
     ::testing::Values(Baseline{"closed-kitten", true, 0.995, 0, 0},
                       Baseline{"closed-bunny-zipper", true, 0.995, 8, 1},
-                      Baseline{"open-bunny-scan-bun000", false, 0.9977, 693, 7},
-                      Baseline{"raw-bunny", false, 0.9887, 23351, 1633},
-                      Baseline{"open-table-mug-stereo", false, 0.9946, 6053, 224},
-                      Baseline{"open-lion-photogrammetry", false, 0.9942, 18207, 726},
-                      Baseline{"open-autzen-lidar", false, 0.9894, 10346, 299},
-                      Baseline{"open-alpe-selle-photogrammetry", false, 0.9849, 2567942, 43316}),
+                      Baseline{"open-bunny-scan-bun000", false, 0.9977, 690, 7},
+                      Baseline{"raw-bunny", false, 0.9820, 18447, 894},
+                      Baseline{"open-table-mug-stereo", false, 0.9930, 5359, 119},
+                      Baseline{"open-lion-photogrammetry", false, 0.9926, 16796, 535},
+                      Baseline{"open-autzen-lidar", false, 0.9887, 10103, 268},
+                      Baseline{"open-alpe-selle-photogrammetry", false, 0.9804, 2477335, 33744}),
     [](const ::testing::TestParamInfo<Baseline>& param) {
       std::string name = param.param.name;
       for (char& c : name) {

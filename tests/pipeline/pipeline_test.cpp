@@ -15,6 +15,7 @@
 #include "g2s/io.hpp"
 #include "g2s/stats.hpp"
 #include "g2s/synth.hpp"
+#include "support/clean_mesh.hpp"
 #include "support/cli.hpp"
 
 namespace {
@@ -44,23 +45,19 @@ void print(const char* what, const g2s::MeshStats& s, const g2s::PipelineMesh& m
 }
 
 void expect_clean(const g2s::MeshStats& s) {
-  EXPECT_EQ(s.non_manifold_edges, 0u);
-  EXPECT_EQ(s.non_manifold_vertices, 0u);
-  EXPECT_EQ(s.orientation_conflicts, 0u);
-  EXPECT_EQ(s.duplicate_triangles, 0u);
-  EXPECT_EQ(s.degenerate_triangles, 0u);
+  g2s::test_support::expect_clean_mesh(s);
 }
 
 // Boundary edges and holes of a mesh cut into tens of tiles against the mesh at the default
 // tiling (a few tiles; both adapt the search to each tile's own spacing, which a single tile
-// over a cloud of two densities cannot): boundary edges within 3% (plus one small hole's border
-// for clouds whose mesh is closed or almost), holes within 10%, since a seam fills only
-// the holes its band reaches (table-mug, 52 tiles: 233 against 213; docs/pipeline.md, "Holes and
-// the tiling").
+// over a cloud of two densities cannot): boundary edges within 5% (plus one small hole's border
+// for clouds whose mesh is closed or almost), holes within 25%, since a seam fills and widens
+// only the holes its band reaches (table-mug, 52 tiles: 137 against 113, the same 20-odd more as
+// before holes were widened, 232 against 213; docs/pipeline.md, "Holes and the tiling").
 void expect_close_to(const g2s::MeshStats& tiled, const g2s::MeshStats& usual) {
   EXPECT_LE(static_cast<double>(tiled.boundary_edges),
-            static_cast<double>(usual.boundary_edges) * 1.03 + 20);
-  EXPECT_LE(static_cast<double>(tiled.holes), static_cast<double>(usual.holes) * 1.10 + 2);
+            static_cast<double>(usual.boundary_edges) * 1.05 + 20);
+  EXPECT_LE(static_cast<double>(tiled.holes), static_cast<double>(usual.holes) * 1.25 + 2);
   EXPECT_GE(tiled.coverage, usual.coverage - 0.002);
 }
 
