@@ -202,7 +202,8 @@ void add_mesh_options(CLI::App& cmd, PipelineOptions& options) {
   cmd.add_option("--max-hole-rings", options.mesh.max_hole_rings,
                  "A hole that cannot be closed over its own points may be widened by up to this "
                  "many rings of triangles and closed in their place, leaving out only points "
-                 "within 3 spacings of the surface (default 3, at most 10; 0 leaves out no point)")
+                 "within 3 spacings of the surface, and scraps of surface that close to the rest "
+                 "are removed (default 3, at most 10; 0 leaves out no point)")
       ->check(count_range(0, MeshOptions::kMaxHoleRings));
   cmd.add_flag(
       "--no-orient", [&options](std::int64_t) { options.mesh.orient = false; },

@@ -307,6 +307,7 @@ class Grower {
   // than one fan left to a single one, with the holes that leaves filled in turn
   // (docs/algorithm.md, "No crossing triangles" and "Hole filling"). Filling first lets a hole
   // between two fans of a point join them, where deleting one fan would leave a larger hole.
+  // Last, scraps of surface near the rest go (remove_scraps).
   void finish_surface() {
     compact(remove_crossings());
     if (options_.max_hole_edges < 3) return;
@@ -322,13 +323,61 @@ class Grower {
     std::vector<Index> unjudged;
     mark_non_manifold_fans(triangles_, grid_.size(), second_fans_, judged, dead, unjudged);
     second_fans_.insert(second_fans_.end(), unjudged.begin(), unjudged.end());
-    if (std::find(dead.begin(), dead.end(), 1) == dead.end()) return;
-    for (std::size_t t = 0; t < triangles_.size(); ++t) {
-      if (!dead[t]) continue;
-      for (Index v : triangles_[t]) second_fans_.push_back(v);
+    if (std::find(dead.begin(), dead.end(), 1) != dead.end()) {
+      for (std::size_t t = 0; t < triangles_.size(); ++t) {
+        if (!dead[t]) continue;
+        for (Index v : triangles_[t]) second_fans_.push_back(v);
+      }
+      compact(std::move(dead));
+      fill_small_holes();
     }
-    compact(std::move(dead));
-    fill_small_holes();
+    if (options_.max_hole_rings > 0) remove_scraps();
+  }
+
+  // Removes the pieces of surface that have no interior point (a lone triangle, a strip: every
+  // corner on an open edge, so not a surface patch of their own) and lie within
+  // kMaxLeftOutDistance spacings of another piece at every corner: on a noisy scan they are
+  // triangles grown in the layer beside the sheet, each a separate hole. Only pieces grown in
+  // this run at points it judges (fillable) go; their points are left out, as widened holes
+  // leave out points near the surface.
+  void remove_scraps() {
+    const auto n = static_cast<std::uint32_t>(grid_.size());
+    std::vector<std::uint32_t> piece(n, kNoIndex);
+    for (const Triangle& t : triangles_) {
+      for (const Index v : t) piece[v] = v;
+    }
+    for (const Triangle& t : triangles_) {
+      const std::uint32_t r0 = find_root(piece, t[0]);
+      piece[find_root(piece, t[1])] = r0;
+      piece[find_root(piece, t[2])] = r0;
+    }
+    for (std::uint32_t v = 0; v < n; ++v) {
+      if (piece[v] != kNoIndex) piece[v] = find_root(piece, v);
+    }
+    // A piece may go unless it has an interior point (one on no open edge), a triangle loaded
+    // before the run or a point this run does not judge.
+    std::vector<std::uint8_t> on_open(n, 0), keep(n, 0);
+    edges_.for_each_open([&](Index u, Index v) { on_open[u] = on_open[v] = 1; });
+    for (std::uint32_t v = 0; v < n; ++v) {
+      if (piece[v] != kNoIndex && (!on_open[v] || !fillable(v))) keep[piece[v]] = 1;
+    }
+    for (std::size_t t = 0; t < preloaded_; ++t) keep[piece[triangles_[t][0]]] = 1;
+    const double radius = kMaxLeftOutDistance * grid_.spacing();
+    for (std::uint32_t v = 0; v < n; ++v) {
+      if (piece[v] == kNoIndex || keep[piece[v]]) continue;
+      bool near = false;
+      grid_.for_each_in_ball(grid_.position(v), radius, [&](std::uint32_t w, double) {
+        near = near || (piece[w] != kNoIndex && piece[w] != piece[v]);
+      });
+      if (!near) keep[piece[v]] = 1;
+    }
+    std::vector<std::uint8_t> dead(triangles_.size(), 0);
+    bool any = false;
+    for (std::size_t t = preloaded_; t < triangles_.size(); ++t) {
+      dead[t] = !keep[piece[triangles_[t][0]]];
+      any = any || dead[t];
+    }
+    if (any) compact(std::move(dead));
   }
 
   // Removes the triangles marked dead, and their edges from the Point-Edge Map (a triangle marked
@@ -1271,7 +1320,8 @@ class Grower {
   static constexpr std::uint8_t kRemove = 1, kUnlinked = 2;
   // How many times a widened border that passes a point twice may take in that point's fan.
   static constexpr int kMaxPinchPasses = 3;
-  // How far (in spacings) from the surface a point that a widened filling leaves out may lie:
+  // How far (in spacings) from the surface a point that a widened filling or a scrap leaves out
+  // may lie:
   // noise spreads a scan's points over a layer a few spacings thick, and the points further out
   // stay vertices.
   static constexpr double kMaxLeftOutDistance = 3;

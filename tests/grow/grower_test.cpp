@@ -1,6 +1,7 @@
 // The grower's gap closing (src/grow/grower.cpp, close_three_edge_gaps) on a hand-made front:
 // three kept triangles around a triangular gap, with a context point in the gap that is every
-// gap edge's Gabriel point but may not join, so the front itself leaves the gap open.
+// gap edge's Gabriel point but may not join, so the front itself leaves the gap open. And the
+// removal of scraps (remove_scraps): a lone triangle near a flat patch, and one far from it.
 #include "grow/grower.hpp"
 
 #include <gtest/gtest.h>
@@ -97,3 +98,58 @@ TEST(GapClosing, AGapIsNotClosedWhereItWouldFold) {
 }
 
 }  // namespace
+
+// Scraps: a flat 24 x 24 patch (spacing 1, jittered) and three points in a small triangle
+// `height` above its middle, out of the front's reach, so that they seed a lone triangle of
+// their own. Returns the grown triangles (input indices); the lone triangle's points are
+// 576-578.
+std::vector<Triangle> grow_patch_with_lone_triangle(float height, int max_hole_rings) {
+  std::vector<float> xyz;
+  std::uint32_t state = 12345;
+  const auto jitter = [&state] {
+    state = state * 1664525u + 1013904223u;
+    return static_cast<float>(state >> 8) / 16777216.0f * 0.2f - 0.1f;
+  };
+  for (int i = 0; i < 24; ++i) {
+    for (int j = 0; j < 24; ++j) {
+      xyz.insert(xyz.end(),
+                 {static_cast<float>(i) + jitter(), static_cast<float>(j) + jitter(), 0});
+    }
+  }
+  xyz.insert(xyz.end(), {11.2f, 11.3f, height, 12.1f, 11.4f, height, 11.6f, 12.2f, height});
+  std::vector<Index> ids(xyz.size() / 3);
+  for (std::size_t k = 0; k < ids.size(); ++k) ids[k] = static_cast<Index>(k);
+  const g2s::HashGrid grid(xyz, ids);
+  g2s::MeshOptions options;
+  options.max_hole_rings = max_hole_rings;
+  const g2s::GrowResult r = g2s::grow_mesh(grid, options);
+  std::vector<Triangle> out;
+  for (const Triangle& t : r.triangles)
+    out.push_back({grid.id(t[0]), grid.id(t[1]), grid.id(t[2])});
+  return out;
+}
+
+bool has_lone_triangle(const std::vector<Triangle>& triangles) {
+  return std::any_of(triangles.begin(), triangles.end(), [](const Triangle& t) {
+    return std::all_of(t.begin(), t.end(), [](Index v) { return v >= 576; });
+  });
+}
+
+bool uses_lone_points(const std::vector<Triangle>& triangles) {
+  return std::any_of(triangles.begin(), triangles.end(), [](const Triangle& t) {
+    return std::any_of(t.begin(), t.end(), [](Index v) { return v >= 576; });
+  });
+}
+
+TEST(Scraps, ALoneTriangleNearTheSurfaceGoesAndItsPointsAreLeftOut) {
+  // Without leaving points out (max_hole_rings 0) the lone triangle is there, so it did grow.
+  ASSERT_TRUE(has_lone_triangle(grow_patch_with_lone_triangle(1.5f, 0)));
+  const std::vector<Triangle> cleaned = grow_patch_with_lone_triangle(1.5f, 3);
+  EXPECT_FALSE(uses_lone_points(cleaned));
+  // The patch itself is untouched.
+  EXPECT_EQ(cleaned.size() + 1, grow_patch_with_lone_triangle(1.5f, 0).size());
+}
+
+TEST(Scraps, ALoneTriangleFarFromTheSurfaceStays) {
+  EXPECT_TRUE(has_lone_triangle(grow_patch_with_lone_triangle(6.0f, 3)));
+}
