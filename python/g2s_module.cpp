@@ -45,6 +45,8 @@ struct MesherArgs {
   double max_fold = 135.0;
   double max_radius = 6.0;
   bool keep_gaps = false;
+  int max_hole_edges = 30;
+  int max_hole_rings = 3;
   bool no_orient = false;
 };
 
@@ -55,6 +57,8 @@ g2s::PipelineOptions pipeline_options(const MesherArgs& m, int threads) {
   options.mesh.max_fold_deg = m.max_fold;
   options.mesh.max_radius = m.max_radius;
   options.mesh.close_gaps = !m.keep_gaps;
+  options.mesh.max_hole_edges = m.max_hole_edges;
+  options.mesh.max_hole_rings = m.max_hole_rings;
   options.mesh.orient = !m.no_orient;
   options.threads = threads;
   return options;
@@ -310,25 +314,27 @@ PYBIND11_MODULE(_g2s, m) {
   });
 
   const auto mesher_args = [](std::optional<std::vector<double>> radius_steps, int flatness_levels,
-                              double max_fold, double max_radius, bool keep_gaps, bool no_orient) {
-    return MesherArgs{
-        std::move(radius_steps), flatness_levels, max_fold, max_radius, keep_gaps, no_orient};
+                              double max_fold, double max_radius, bool keep_gaps,
+                              int max_hole_edges, int max_hole_rings, bool no_orient) {
+    return MesherArgs{std::move(radius_steps), flatness_levels, max_fold, max_radius, keep_gaps,
+                      max_hole_edges,          max_hole_rings,  no_orient};
   };
   m.def(
       "mesh",
       [mesher_args](const py::array& points, std::optional<int> threads,
                     std::optional<std::uint64_t> memory, std::uint64_t tile_points,
                     std::optional<std::vector<double>> radius_steps, int flatness_levels,
-                    double max_fold, double max_radius, bool keep_gaps, bool no_orient) {
+                    double max_fold, double max_radius, bool keep_gaps, int max_hole_edges,
+                    int max_hole_rings, bool no_orient) {
         return mesh(points, threads, memory, tile_points,
                     mesher_args(std::move(radius_steps), flatness_levels, max_fold, max_radius,
-                                keep_gaps, no_orient));
+                                keep_gaps, max_hole_edges, max_hole_rings, no_orient));
       },
       py::arg("points"), py::kw_only(), py::arg("threads") = py::none(),
       py::arg("memory") = py::none(), py::arg("tile_points") = 0,
       py::arg("radius_steps") = py::none(), py::arg("flatness_levels") = 4,
       py::arg("max_fold") = 135.0, py::arg("max_radius") = 6.0, py::arg("keep_gaps") = false,
-      py::arg("no_orient") = false);
+      py::arg("max_hole_edges") = 30, py::arg("max_hole_rings") = 3, py::arg("no_orient") = false);
   m.def(
       "mesh_file",
       [mesher_args](const std::filesystem::path& input, const std::filesystem::path& output,
@@ -336,17 +342,19 @@ PYBIND11_MODULE(_g2s, m) {
                     std::uint64_t tile_points, std::optional<std::filesystem::path> keep_store,
                     bool compress, bool ascii, bool no_stats,
                     std::optional<std::vector<double>> radius_steps, int flatness_levels,
-                    double max_fold, double max_radius, bool keep_gaps, bool no_orient) {
+                    double max_fold, double max_radius, bool keep_gaps, int max_hole_edges,
+                    int max_hole_rings, bool no_orient) {
         return mesh_file(input, output, threads, memory, tile_points, keep_store, compress, ascii,
                          no_stats,
                          mesher_args(std::move(radius_steps), flatness_levels, max_fold, max_radius,
-                                     keep_gaps, no_orient));
+                                     keep_gaps, max_hole_edges, max_hole_rings, no_orient));
       },
       py::arg("input"), py::arg("output"), py::kw_only(), py::arg("threads") = py::none(),
       py::arg("memory") = py::none(), py::arg("tile_points") = 0,
       py::arg("keep_store") = py::none(), py::arg("compress") = false, py::arg("ascii") = false,
       py::arg("no_stats") = false, py::arg("radius_steps") = py::none(),
       py::arg("flatness_levels") = 4, py::arg("max_fold") = 135.0, py::arg("max_radius") = 6.0,
-      py::arg("keep_gaps") = false, py::arg("no_orient") = false);
+      py::arg("keep_gaps") = false, py::arg("max_hole_edges") = 30, py::arg("max_hole_rings") = 3,
+      py::arg("no_orient") = false);
   m.def("stats", &stats, py::arg("points"), py::arg("triangles"));
 }
