@@ -2,21 +2,26 @@
 // with bounded memory. Pass 1 finds the bounding box and a deterministic sample; the box is
 // split k-d style at box midpoints or sample quantiles (tile_split.hpp); when the sample did
 // not hold every point, counting passes check the tiles and re-split any over budget. Then the
-// blocks are written in rounds of consecutive tiles holding at most round_points points, each
-// round re-reading the input and keeping only its tiles' points. Points are taken in input
+// blocks are written in rounds of consecutive tiles holding at most round_points points. One
+// round takes its points from one more pass over the input; several take them from a spill
+// file that one pass has scattered every point to, in per-tile runs. Points are taken in input
 // order, sorted by a total order, and frames encoded in parallel but written in order, so the
-// bytes do not depend on threads or timing.
+// bytes do not depend on round_points, threads or timing.
+#include <fcntl.h>
 #include <fmt/core.h>
 #include <sys/stat.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
+#include <unistd.h>
 #include <zstd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -40,6 +45,10 @@ constexpr std::size_t kSampleTarget = std::size_t{1} << 18;
 // A tile split on a partial sample aims this far below the budget, so that the counting pass
 // rarely finds one over it.
 constexpr double kSampledTargetFraction = 0.75;
+// The spill pass's per-tile buffers share this much (one point a tile at least, which is less
+// than the tile's table entry): 124 KB a tile for the 258 tiles of 160M points under --memory
+// 1G, so each write moves over 100 KB at once, and freed before the rounds allocate theirs.
+constexpr std::size_t kSpillBufferBytes = std::size_t{32} << 20;
 
 // Streams the finite points of the input with their global ids; returns the reader's report.
 template <class Visit>
@@ -127,6 +136,98 @@ std::vector<std::uint64_t> split_into_tiles(const std::filesystem::path& input, 
     // Only tiles of coinciding points are left over budget: no plane separates them.
     if (!split_any) return counts;
   }
+}
+
+// Beyond one round, the points in tile order (x, y, z of every point, then every id; a tile's
+// points in input order), so that a round reads its consecutive tiles back in two reads rather
+// than the whole input. Beside the store, and unlinked as soon as it is open: the kernel frees
+// it when it is closed, however the process ends (even killed).
+class SpillFile {
+ public:
+  SpillFile(const AtomicFile& store, std::uint64_t bytes)
+      : target_(store.target()), path_(store.temporary().string() + ".spill") {
+    fd_ = ::open(path_.path().c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    if (fd_ < 0) fail("cannot create the spill file");
+    ::unlink(path_.path().c_str());
+    // Reserved up front, so a full disk fails now rather than a pass later (where the
+    // filesystem cannot reserve, at the write that does not fit).
+    if (::fallocate(fd_, 0, 0, static_cast<off_t>(bytes)) != 0 && errno != EOPNOTSUPP) {
+      fail("cannot write the spill file");
+    }
+  }
+  ~SpillFile() { ::close(fd_); }
+  SpillFile(const SpillFile&) = delete;
+  SpillFile& operator=(const SpillFile&) = delete;
+
+  void write_at(std::uint64_t offset, const void* data, std::size_t bytes) {
+    const char* p = static_cast<const char*>(data);
+    while (bytes > 0) {
+      const ssize_t n = ::pwrite(fd_, p, bytes, static_cast<off_t>(offset));
+      if (n < 0 && errno == EINTR) continue;
+      if (n == 0) errno = EIO;
+      if (n <= 0) fail("cannot write the spill file");
+      p += n;
+      bytes -= static_cast<std::size_t>(n);
+      offset += static_cast<std::uint64_t>(n);
+    }
+  }
+
+  void read_at(std::uint64_t offset, void* data, std::size_t bytes) const {
+    char* p = static_cast<char*>(data);
+    while (bytes > 0) {
+      const ssize_t n = ::pread(fd_, p, bytes, static_cast<off_t>(offset));
+      if (n < 0 && errno == EINTR) continue;
+      if (n == 0) errno = EIO;
+      if (n <= 0) fail("cannot read back the spill file");
+      p += n;
+      bytes -= static_cast<std::size_t>(n);
+      offset += static_cast<std::uint64_t>(n);
+    }
+  }
+
+ private:
+  [[noreturn]] void fail(const char* what) const {
+    throw Error(Exit::write_failed,
+                fmt::format("{}: {}: {}", target_.string(), what, std::strerror(errno)));
+  }
+
+  std::filesystem::path target_;
+  TemporaryPath path_;  // removes the name should a signal come before the unlink
+  int fd_ = -1;
+};
+
+// The spill pass: each point goes to its tile's buffer, and a full buffer to the tile's run at
+// the tile's running offset. `tile_start` holds each tile's first point in tile order, then the
+// total.
+void spill_points(const std::filesystem::path& input, const TileTree& tree,
+                  std::span<const std::uint32_t> tile_of_node,
+                  std::span<const std::uint64_t> tile_start, const ReadReport& report,
+                  SpillFile& spill) {
+  const std::size_t tiles = tile_start.size() - 1;
+  const std::uint64_t ids_offset = 3 * sizeof(double) * tile_start[tiles];
+  const std::size_t per_tile = std::max<std::size_t>(kSpillBufferBytes / (kPointBytes * tiles), 1);
+  std::vector<double> xyz(3 * per_tile * tiles);
+  std::vector<Index> ids(per_tile * tiles);
+  std::vector<std::uint64_t> flushed(tile_start.begin(), tile_start.end() - 1);  // in tile order
+  std::vector<std::size_t> held(tiles, 0);
+  const auto flush = [&](std::size_t t) {
+    spill.write_at(3 * sizeof(double) * flushed[t], &xyz[3 * per_tile * t],
+                   3 * sizeof(double) * held[t]);
+    spill.write_at(ids_offset + sizeof(Index) * flushed[t], &ids[per_tile * t],
+                   sizeof(Index) * held[t]);
+    flushed[t] += held[t];
+    held[t] = 0;
+  };
+  const ReadReport again = for_each_point(input, [&](const double* p, std::uint64_t id) {
+    const std::uint32_t t = tile_of_node[tree.leaf_of(p)];
+    if (flushed[t] + held[t] == tile_start[t + 1]) throw_changed(input);  // before overrunning
+    const std::size_t at = per_tile * t + held[t];
+    std::copy_n(p, 3, &xyz[3 * at]);
+    ids[at] = static_cast<Index>(id);
+    if (++held[t] == per_tile) flush(t);
+  });
+  check_unchanged(input, report, again);
+  for (std::size_t t = 0; t < tiles; ++t) flush(t);
 }
 
 struct BlockEntry {
@@ -323,20 +424,24 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
   // The point buffers are sized once for the largest, so they never reallocate (a copy would
   // double the peak).
   const std::uint64_t round_points = std::max(options.round_points, options.tile_points);
+  std::vector<std::uint64_t> tile_start(tiles + 1, 0);  // each tile's first point in tile order
   std::vector<std::size_t> round_first = {0};
-  std::vector<std::uint64_t> start(tiles + 1, 0);  // each tile's offset in its round's buffers
   std::uint64_t largest_round = 0;
   for (std::size_t t = 0; t < tiles; ++t) {
-    const std::uint64_t held = start[t];
-    const std::uint64_t count = counts[leaves[t]];
-    if (held > 0 && held + count > round_points) {
-      round_first.push_back(t);
-      start[t] = 0;
-    }
-    start[t + 1] = start[t] + count;
-    largest_round = std::max(largest_round, start[t + 1]);
+    tile_start[t + 1] = tile_start[t] + counts[leaves[t]];
+    const std::uint64_t base = tile_start[round_first.back()];
+    if (tile_start[t] > base && tile_start[t + 1] - base > round_points) round_first.push_back(t);
+    largest_round = std::max(largest_round, tile_start[t + 1] - tile_start[round_first.back()]);
   }
   round_first.push_back(tiles);
+
+  // One round reads its points from the input; several read theirs from the spill file, which
+  // one pass fills (its buffers are freed before the rounds' are allocated).
+  std::unique_ptr<SpillFile> spill;
+  if (round_first.size() > 2) {
+    spill = std::make_unique<SpillFile>(file, kPointBytes * total);
+    spill_points(input, tree, tile_of_node, tile_start, first, *spill);
+  }
 
   BlockScratch scratch;
   std::vector<double> xyz(largest_round * 3);
@@ -345,26 +450,35 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
   for (std::size_t round = 0; round + 1 < round_first.size(); ++round) {
     const std::size_t round_begin = round_first[round];
     const std::size_t round_end = round_first[round + 1];
-    std::vector<std::uint64_t> cursor(start.begin() + round_begin, start.begin() + round_end);
-    const ReadReport again = for_each_point(input, [&](const double* p, std::uint64_t id) {
-      const std::uint32_t t = tile_of_node[tree.leaf_of(p)];
-      if (t < round_begin || t >= round_end) return;
-      const std::uint64_t at = cursor[t - round_begin]++;
-      if (at - start[t] >= counts[leaves[t]]) throw_changed(input);  // before overrunning
-      std::copy_n(p, 3, &xyz[3 * at]);
-      ids[at] = static_cast<Index>(id);
-    });
-    check_unchanged(input, first, again);
+    const std::uint64_t base = tile_start[round_begin];  // the round's first point in tile order
+    if (spill) {
+      const std::size_t n = tile_start[round_end] - base;
+      spill->read_at(3 * sizeof(double) * base, xyz.data(), 3 * sizeof(double) * n);
+      spill->read_at(3 * sizeof(double) * total + sizeof(Index) * base, ids.data(),
+                     sizeof(Index) * n);
+    } else {
+      std::vector<std::uint64_t> cursor(tile_start.begin() + round_begin,
+                                        tile_start.begin() + round_end);
+      const ReadReport again = for_each_point(input, [&](const double* p, std::uint64_t id) {
+        const std::uint32_t t = tile_of_node[tree.leaf_of(p)];
+        if (t < round_begin || t >= round_end) return;
+        const std::uint64_t at = cursor[t - round_begin]++;
+        if (at == tile_start[t + 1]) throw_changed(input);  // before overrunning
+        std::copy_n(p, 3, &xyz[3 * (at - base)]);
+        ids[at - base] = static_cast<Index>(id);
+      });
+      check_unchanged(input, first, again);
+    }
     // The spacing estimates of the round's tiles, in parallel (each is a serial pass over its
     // tile); the blocks are then written one by one, each encoded in parallel.
     std::vector<double> spacing(round_end - round_begin);
     tbb::parallel_for(round_begin, round_end, [&](std::size_t t) {
       spacing[t - round_begin] = estimate_tile_spacing(
-          std::span<const double>(xyz.data() + 3 * start[t], 3 * counts[leaves[t]]));
+          std::span<const double>(xyz.data() + 3 * (tile_start[t] - base), 3 * counts[leaves[t]]));
     });
     for (std::size_t t = round_begin; t < round_end; ++t) {
       const std::uint32_t node = leaves[t];
-      const std::size_t begin = start[t];
+      const std::size_t begin = tile_start[t] - base;
       const std::size_t n = counts[node];
       const std::span<const double> tile_xyz(xyz.data() + 3 * begin, 3 * n);
       const BlockEntry block =

@@ -7,15 +7,19 @@
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <stdlib.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <zstd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -366,6 +370,63 @@ TEST_F(TileStoreTest, BytesAreDeterministicWhateverTheRoundsAndThreads) {
     EXPECT_EQ(once, rounds);
     EXPECT_EQ(once, one_thread);
   }
+}
+
+TEST_F(TileStoreTest, SpillFileGivesTheBytesOfOneRound) {
+  // Several rounds take their points from the spill file, one round from the input: the same
+  // bytes whether a round holds one tile, a few or most, binary or text input (NaN points
+  // dropped), raw or compressed; and nothing but the store is left beside it.
+  std::string text;
+  for (int i = 0; i < 20000; ++i) {
+    text += fmt::format("{} {} {}\n", std::cos(i * 0.01) * 3, std::sin(i * 0.013) * 3, i * 0.001);
+    if (i % 97 == 0) text += "nan 1 1\n";
+  }
+  const fs::path inputs[] = {synthetic("torus.ply", g2s::SynthShape::torus, 60'000),
+                             write("c.xyz", text)};
+  for (const fs::path& input : inputs) {
+    for (const bool compress : {false, true}) {
+      const std::string one_round = file_bytes(build(input, "one.tiles", 2000, compress));
+      for (const std::uint64_t round_points : {1u, 7'000u, 40'000u}) {
+        EXPECT_EQ(file_bytes(build(input, "spill.tiles", 2000, compress, round_points)), one_round)
+            << input << " compress " << compress << " round_points " << round_points;
+      }
+    }
+  }
+  std::vector<std::string> left;
+  for (const auto& entry : fs::directory_iterator(dir_)) {
+    left.push_back(entry.path().filename().string());
+  }
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(left, (std::vector<std::string>{"c.xyz", "one.tiles", "spill.tiles", "torus.ply"}));
+}
+
+TEST_F(TileStoreTest, FullDiskForTheSpillFileLeavesNothing) {
+  // In a fresh process (a forked one would inherit TBB's threads half-made) whose files may
+  // not grow past 256 KB (SIGXFSZ ignored, so writes fail with EFBIG, as on a full disk): the
+  // 1.4 MB spill file does not fit, and the error names the store and the reason, with nothing
+  // left behind.
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  const fs::path input = synthetic("cube.ply", g2s::SynthShape::cube, 50'000);
+  const auto tile_with_a_full_disk = [&] {
+    ::signal(SIGXFSZ, SIG_IGN);
+    const rlimit limit{256 << 10, 256 << 10};
+    int code = ::setrlimit(RLIMIT_FSIZE, &limit) == 0 ? 10 : 20;  // 10: no error
+    try {
+      build(input, "s.tiles", 3000, false, 1);
+    } catch (const g2s::Error& e) {
+      std::fprintf(stderr, "%s\n", e.what());
+      if (code == 10) code = e.code() == Exit::write_failed ? 0 : 11;
+    }
+    for (const auto& entry : fs::directory_iterator(dir_)) {
+      if (entry.path() == input) continue;
+      std::fprintf(stderr, "left: %s\n", entry.path().c_str());
+      code = 12;
+    }
+    fs::remove_all(dir_);
+    std::_Exit(code);
+  };
+  EXPECT_EXIT(tile_with_a_full_disk(), ::testing::ExitedWithCode(0),
+              fmt::format("s\\.tiles: cannot write the spill file: {}", std::strerror(EFBIG)));
 }
 
 TEST_F(TileStoreTest, SampledSplitIsCheckedByCounting) {
