@@ -44,10 +44,10 @@ struct TileStoreOptions {
   bool compress = false;  // zstd-compress the point blocks
   int zstd_level = 1;
   // Points the writer holds in memory at once (28 bytes each; at least tile_points): the bound
-  // on its memory. A larger cloud is written in several rounds of whole tiles, each re-reading
-  // the input. Added with the implementation: the memory bound is the caller's to choose, and
-  // the tests need several rounds without a 100M-point file. The bytes written do not depend
-  // on it.
+  // on its memory. A larger cloud is written in several rounds of whole tiles, read back from
+  // a temporary spill file beside the store (28 bytes a point) that one pass over the input
+  // fills. Added with the implementation: the memory bound is the caller's to choose, and the
+  // tests need several rounds without a 100M-point file. The bytes written do not depend on it.
   std::uint64_t round_points = std::uint64_t{8} << 20;
   // Called now and then with (points done, points in total) while writing; may be empty.
   std::function<void(std::uint64_t, std::uint64_t)> progress;

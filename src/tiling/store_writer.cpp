@@ -152,7 +152,9 @@ class SpillFile {
     // Reserved up front, so a full disk fails now rather than a pass later (where the
     // filesystem cannot reserve, at the write that does not fit).
     if (::fallocate(fd_, 0, 0, static_cast<off_t>(bytes)) != 0 && errno != EOPNOTSUPP) {
-      fail("cannot write the spill file");
+      const int err = errno;
+      ::close(fd_);  // no destructor runs after a constructor throws
+      fail("cannot write the spill file", err);
     }
   }
   ~SpillFile() { ::close(fd_); }
@@ -160,35 +162,29 @@ class SpillFile {
   SpillFile& operator=(const SpillFile&) = delete;
 
   void write_at(std::uint64_t offset, const void* data, std::size_t bytes) {
-    const char* p = static_cast<const char*>(data);
-    while (bytes > 0) {
-      const ssize_t n = ::pwrite(fd_, p, bytes, static_cast<off_t>(offset));
-      if (n < 0 && errno == EINTR) continue;
-      if (n == 0) errno = EIO;
-      if (n <= 0) fail("cannot write the spill file");
-      p += n;
-      bytes -= static_cast<std::size_t>(n);
-      offset += static_cast<std::uint64_t>(n);
-    }
+    whole(::pwrite, static_cast<const char*>(data), bytes, offset, "cannot write the spill file");
   }
-
   void read_at(std::uint64_t offset, void* data, std::size_t bytes) const {
-    char* p = static_cast<char*>(data);
-    while (bytes > 0) {
-      const ssize_t n = ::pread(fd_, p, bytes, static_cast<off_t>(offset));
-      if (n < 0 && errno == EINTR) continue;
-      if (n == 0) errno = EIO;
-      if (n <= 0) fail("cannot read back the spill file");
-      p += n;
-      bytes -= static_cast<std::size_t>(n);
-      offset += static_cast<std::uint64_t>(n);
-    }
+    whole(::pread, static_cast<char*>(data), bytes, offset, "cannot read back the spill file");
   }
 
  private:
-  [[noreturn]] void fail(const char* what) const {
+  // Calls pwrite or pread until all `bytes` are done (they may do less, or be interrupted).
+  template <class Call, class Byte>
+  void whole(Call call, Byte* p, std::size_t bytes, std::uint64_t offset, const char* what) const {
+    while (bytes > 0) {
+      const ssize_t n = call(fd_, p, bytes, static_cast<off_t>(offset));
+      if (n < 0 && errno == EINTR) continue;
+      if (n == 0) errno = EIO;
+      if (n <= 0) fail(what);
+      p += n;
+      bytes -= static_cast<std::size_t>(n);
+      offset += static_cast<std::uint64_t>(n);
+    }
+  }
+  [[noreturn]] void fail(const char* what, int err = errno) const {
     throw Error(Exit::write_failed,
-                fmt::format("{}: {}: {}", target_.string(), what, std::strerror(errno)));
+                fmt::format("{}: {}: {}", target_.string(), what, std::strerror(err)));
   }
 
   std::filesystem::path target_;
