@@ -1316,8 +1316,9 @@ class Grower {
   // Per point: kUsed once it is a corner, plus the number of open edges at it; one array, so
   // that the interior test of every point a search ball holds is a single load.
   static constexpr std::uint32_t kUsed = 0x80000000u;
-  // Marks for compact: removed with its edges, or off the Point-Edge Map already.
-  static constexpr std::uint8_t kRemove = 1, kUnlinked = 2;
+  // A mark for compact: off the Point-Edge Map already (any other non-zero mark: removed with its
+  // edges).
+  static constexpr std::uint8_t kUnlinked = 2;
   // How many times a widened border that passes a point twice may take in that point's fan.
   static constexpr int kMaxPinchPasses = 3;
   // How far (in spacings) from the surface a point that a widened filling or a scrap leaves out
