@@ -39,8 +39,9 @@ struct MeshOptions {
   // folds over it) may be widened by up to this many rings of triangles around it and filled in
   // their place, leaving out the points inside that lie within 3 spacings of the surface
   // (docs/algorithm.md, "Hole filling"); scraps (pieces with no interior point within 3 spacings
-  // of another piece) are removed too. 0: every hole is filled over its own loop or not at all,
-  // and no point is left out. At most kMaxHoleRings.
+  // of another piece) are removed too, when holes are filled at all (max_hole_edges >= 3). 0: every
+  // hole is filled over its own loop or not at all, and no point is left out. At most
+  // kMaxHoleRings.
   int max_hole_rings = 3;
   static constexpr int kMaxHoleRings = 10;
   // Orient each closed component outward (open, mostly horizontal ones up; see

@@ -50,10 +50,6 @@ bool traverses(const Triangle& t, Index u, Index v) {
   return (t[0] == u && t[1] == v) || (t[1] == u && t[2] == v) || (t[2] == u && t[0] == v);
 }
 
-std::pair<Index, Index> ordered(Index u, Index v) {
-  return {std::min(u, v), std::max(u, v)};
-}
-
 std::uint64_t edge_key(Index u, Index v) {
   return std::uint64_t{std::min(u, v)} << 32 | std::max(u, v);
 }
@@ -342,18 +338,7 @@ class Grower {
   // leave out points near the surface.
   void remove_scraps() {
     const auto n = static_cast<std::uint32_t>(grid_.size());
-    std::vector<std::uint32_t> piece(n, kNoIndex);
-    for (const Triangle& t : triangles_) {
-      for (const Index v : t) piece[v] = v;
-    }
-    for (const Triangle& t : triangles_) {
-      const std::uint32_t r0 = find_root(piece, t[0]);
-      piece[find_root(piece, t[1])] = r0;
-      piece[find_root(piece, t[2])] = r0;
-    }
-    for (std::uint32_t v = 0; v < n; ++v) {
-      if (piece[v] != kNoIndex) piece[v] = find_root(piece, v);
-    }
+    const std::vector<std::uint32_t> piece = pieces();
     // A piece may go unless it has an interior point (one on no open edge), a triangle loaded
     // before the run or a point this run does not judge.
     std::vector<std::uint8_t> on_open(n, 0), keep(n, 0);
@@ -378,6 +363,25 @@ class Grower {
       any = any || dead[t];
     }
     if (any) compact(std::move(dead));
+  }
+
+  // Per point, the surface piece it is a corner of (a representative point of it: the triangles
+  // sharing corners are one piece), or kNoIndex for a point no triangle uses.
+  std::vector<std::uint32_t> pieces() const {
+    const auto n = static_cast<std::uint32_t>(grid_.size());
+    std::vector<std::uint32_t> piece(n, kNoIndex);
+    for (const Triangle& t : triangles_) {
+      for (const Index v : t) piece[v] = v;
+    }
+    for (const Triangle& t : triangles_) {
+      const std::uint32_t r0 = find_root(piece, t[0]);
+      piece[find_root(piece, t[1])] = r0;
+      piece[find_root(piece, t[2])] = r0;
+    }
+    for (std::uint32_t v = 0; v < n; ++v) {
+      if (piece[v] != kNoIndex) piece[v] = find_root(piece, v);
+    }
+    return piece;
   }
 
   // Removes the triangles marked dead, and their edges from the Point-Edge Map (a triangle marked
@@ -490,22 +494,15 @@ class Grower {
       std::uint32_t begin, length, component;
       bool closable;
     };
-    std::vector<std::uint32_t> piece(grid_.size());
-    for (std::uint32_t v = 0; v < grid_.size(); ++v) piece[v] = v;
-    for (std::uint32_t t = 0; t < grown; ++t) {
-      const Triangle& tri = triangles_[t];
-      const std::uint32_t r0 = find_root(piece, tri[0]);
-      piece[find_root(piece, tri[1])] = r0;
-      piece[find_root(piece, tri[2])] = r0;
-    }
+    const std::vector<std::uint32_t> piece = pieces();
     std::vector<Loop> loops;
     std::vector<std::uint32_t> loop_edges, trace;
     std::vector<std::uint8_t> taken(open.size(), 0);
     std::vector<std::uint32_t> at(grid_.size(), kNoIndex);  // a point's place in `trace`
     const auto close_loop = [&](std::size_t from, bool closed) {
       Loop l{static_cast<std::uint32_t>(loop_edges.size()),
-             static_cast<std::uint32_t>(trace.size() - from),
-             find_root(piece, open[trace[from]].from), closed};
+             static_cast<std::uint32_t>(trace.size() - from), piece[open[trace[from]].from],
+             closed};
       for (std::size_t k = from; k < trace.size(); ++k) {
         const Index v = open[trace[k]].from;
         l.closable = l.closable && fillable(v);
@@ -649,9 +646,9 @@ class Grower {
     std::vector<Index> loop;
     std::vector<std::uint32_t> outside;
     std::vector<Vec3> around;
-    std::vector<std::uint32_t> ring;                   // sorted
-    std::vector<std::pair<Index, Index>> inner_edges;  // sorted, (smaller, larger)
-    std::vector<std::uint32_t> merged;                 // the holes it fills (HoleIndex loops)
+    std::vector<std::uint32_t> ring;         // sorted
+    std::vector<std::uint64_t> inner_edges;  // sorted edge_keys
+    std::vector<std::uint32_t> merged;       // the holes it fills (HoleIndex loops)
 
     void clear() {
       merged.clear();
@@ -670,8 +667,8 @@ class Grower {
   };
 
   // Whether every point a widened hole's filling leaves out (a corner of its ring that is not on
-  // its loop) lies within two spacings of the filling or of a live triangle near the loop
-  // (loop_near_): a hole is closed by leaving out only points close to the surface.
+  // its loop) lies within kMaxLeftOutDistance spacings of the filling or of a live triangle near
+  // the loop (loop_near_): a hole is closed by leaving out only points close to the surface.
   bool leaves_out_only_near(const Attempt& attempt, std::span<const Triangle> fill,
                             const std::vector<std::uint8_t>& dead) const {
     const double limit = kMaxLeftOutDistance * grid_.spacing(), limit2 = limit * limit;
@@ -712,7 +709,7 @@ class Grower {
       const Index u = loop_[i], v = loop_[j];
       return edges_.find(u, v) == EdgeMap::kMissing ||
              std::binary_search(attempt.inner_edges.begin(), attempt.inner_edges.end(),
-                                ordered(u, v));
+                                edge_key(u, v));
     };
     // Every filling triangle lies in the loop's box: the grown triangles that may cross one
     // are those whose boxes overlap it, found once per loop. Rings taken by other fillings
@@ -829,7 +826,7 @@ class Grower {
     for (std::size_t a = 0, b = 0; a < ring_edges_.size(); a = b) {
       while (b < ring_edges_.size() && ring_edges_[b].first == ring_edges_[a].first) ++b;
       const Border& e = ring_edges_[a].second;
-      attempt.inner_edges.push_back(ordered(e.from, e.to));
+      attempt.inner_edges.push_back(ring_edges_[a].first);
       if (b - a == 2) continue;
       if (triangles_on(e.from, e.to) == 2) {
         border_.push_back(e);
@@ -999,17 +996,16 @@ class Grower {
     }
     const std::span<const std::uint32_t> ring(fill_rings_.data() + record.ring_begin,
                                               record.ring_size);
-    std::vector<std::pair<Index, Index>> ring_edges;
+    std::vector<std::uint64_t> ring_edges;
     for (const std::uint32_t r : ring) {
       const Triangle& tri = triangles_[r];
-      for (int k = 0; k < 3; ++k) {
-        ring_edges.push_back(ordered(tri[k], tri[(k + 1) % 3]));
-      }
+      for (int k = 0; k < 3; ++k) ring_edges.push_back(edge_key(tri[k], tri[(k + 1) % 3]));
     }
     std::sort(ring_edges.begin(), ring_edges.end());
     for (std::size_t a = 0, b = 0; a < ring_edges.size(); a = b) {
       while (b < ring_edges.size() && ring_edges[b] == ring_edges[a]) ++b;
-      if (triangles_on(ring_edges[a].first, ring_edges[a].second) + (b - a) > 2) return;
+      const auto u = static_cast<Index>(ring_edges[a] >> 32), v = static_cast<Index>(ring_edges[a]);
+      if (triangles_on(u, v) + (b - a) > 2) return;
     }
     for (const std::uint32_t r : ring) {
       dead[r] = 0;
@@ -1322,9 +1318,8 @@ class Grower {
   // How many times a widened border that passes a point twice may take in that point's fan.
   static constexpr int kMaxPinchPasses = 3;
   // How far (in spacings) from the surface a point that a widened filling or a scrap leaves out
-  // may lie:
-  // noise spreads a scan's points over a layer a few spacings thick, and the points further out
-  // stay vertices.
+  // may lie: noise spreads a scan's points over a layer a few spacings thick, and the points
+  // farther out stay vertices.
   static constexpr double kMaxLeftOutDistance = 3;
   std::vector<std::uint32_t> state_;
   std::vector<FrontEdge> stalled_;  // edges that left the queue without a triangle (stall())
