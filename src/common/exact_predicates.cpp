@@ -287,6 +287,12 @@ int orient3d(const double* a, const double* b, const double* c, const double* d)
   const double bound = kOrient3dBound * permanent;
   if (det > bound) return 1;
   if (-det > bound) return -1;
+  // Four points with one coordinate in common lie in a plane parallel to an axis: quantized
+  // scans (depth images, LAS's integer coordinates) give many such exact zeros, which the
+  // filter can never decide.
+  for (int k = 0; k < 3; ++k) {
+    if (a[k] == b[k] && a[k] == c[k] && a[k] == d[k]) return 0;
+  }
   return orient3d_exact(a, b, c, d);
 }
 

@@ -717,16 +717,10 @@ class Grower {
     detail::Box loop_box{grid_.point(loop_[0]), grid_.point(loop_[0])};
     for (const Index v : loop_) loop_box = detail::enclose(loop_box, grid_.point(v));
     loop_near_.clear();
+    last_blocker_ = kNoIndex;
     cells.for_each_near(loop_box.lo, loop_box.hi, [&](std::uint32_t other, const detail::Box& box) {
       if (attempt.in_ring(other)) return;
-      const Triangle& o = triangles_[other];
-      NearTriangle near{other, box, {}};
-      if (!detail::padded_circumball(grid_.position(o[0]), grid_.position(o[1]),
-                                     grid_.position(o[2]), near.ball)) {
-        if (detail::degenerate(grid_.points(), o)) return;  // crosses none
-        near.ball.radius2 = -1;
-      }
-      loop_near_.push_back(near);
+      loop_near_.push_back({other, box, {{}, kBallUnknown}});
     });
     const auto triangle_ok = [&](std::size_t i, std::size_t k, std::size_t j) {
       return fill_fits({loop_[i], loop_[k], loop_[j]});
@@ -955,12 +949,25 @@ class Grower {
       });
       if (covers_context) return false;
     }
-    for (const NearTriangle& near : loop_near_) {
-      if (!detail::overlap(box, near.box)) continue;
+    const auto blocks = [&](NearTriangle& near) {
+      if (!detail::overlap(box, near.box)) return false;
       const Triangle& o = triangles_[near.index];
-      if (std::is_permutation(o.begin(), o.end(), t.begin())) return false;
-      if (!detail::apart(grid_.points(), t, ball, o, near.ball) &&
-          detail::triangles_cross(grid_.points(), t, o)) {
+      // Most triangles near a loop overlap no candidate's box: their balls wait until one does.
+      if (near.ball.radius2 == kBallUnknown &&
+          !detail::padded_circumball(grid_.position(o[0]), grid_.position(o[1]),
+                                     grid_.position(o[2]), near.ball)) {
+        near.ball.radius2 = -1;  // none: apart() decides nothing, the exact test does
+      }
+      return std::is_permutation(o.begin(), o.end(), t.begin()) ||
+             (!detail::apart(grid_.points(), t, ball, o, near.ball) &&
+              detail::triangles_cross(grid_.points(), t, o));
+    };
+    // The triangle that refused the last candidate is asked first: where the surface folds over
+    // a hole, one grown triangle refuses most of the candidates across it.
+    if (last_blocker_ < loop_near_.size() && blocks(loop_near_[last_blocker_])) return false;
+    for (std::uint32_t i = 0; i < loop_near_.size(); ++i) {
+      if (i != last_blocker_ && blocks(loop_near_[i])) {
+        last_blocker_ = i;
         return false;
       }
     }
@@ -1339,14 +1346,16 @@ class Grower {
   std::vector<WalkPoint> cand_;
   std::vector<Index> excluded_;  // points a retried edge has already failed with
   std::vector<std::pair<double, std::uint32_t>> near_;
-  // fill_holes: the grown triangles near the loop being filled (none degenerate), with their
-  // boxes and padded circumballs (radius2 < 0: none)
+  // fill_holes: the grown triangles near the loop being filled, with their boxes and padded
+  // circumballs (radius2 -1: none; kBallUnknown: not computed yet)
+  static constexpr double kBallUnknown = -2;
   struct NearTriangle {
     std::uint32_t index;
     detail::Box box;
     Ball ball;
   };
   std::vector<NearTriangle> loop_near_;
+  std::uint32_t last_blocker_ = kNoIndex;  // fill_fits: the place in loop_near_ that refused last
   // An edge of a widened hole's border, as the triangle outside it faces (outside, once found).
   struct Border {
     Index from, to;
