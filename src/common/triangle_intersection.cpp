@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "common/exact_predicates.hpp"
 
@@ -108,6 +109,34 @@ bool strictly_one_side(const int side[3]) {
   return (side[0] > 0 && side[1] > 0 && side[2] > 0) || (side[0] < 0 && side[1] < 0 && side[2] < 0);
 }
 
+// The corner of a triangle alone on its side of a plane, given the three corners' sides (none
+// zero, not all equal).
+int alone(const int side[3]) {
+  return side[0] == side[1] ? 2 : side[0] == side[2] ? 1 : 0;
+}
+
+// No shared corner, each triangle with one corner strictly on one side of the other's plane and
+// two strictly on the other (Guigue and Devillers' test): each meets the other's plane in a
+// segment on the planes' common line, and the triangles meet when those segments overlap. With
+// a's lone corner p1 above b's plane (b's order reversed if need be) and b's lone corner p2
+// above a's plane (a's other corners swapped if need be), a's segment starts on edge p1 r1 and
+// ends on p1 q1, b's starts on p2 q2 and ends on p2 r2, along the line; they overlap when b's
+// start is not after a's end and a's start not after b's end, two orientations.
+bool straddling_triangles_meet(const Point a[3], const int a_side[3], const Point b[3],
+                               const int b_side[3]) {
+  const int i = alone(a_side);
+  Point p1 = a[i], q1 = a[(i + 1) % 3], r1 = a[(i + 2) % 3];
+  // b as it faces with p1 above its plane, with its sides against a's plane.
+  const bool reverse_b = a_side[i] < 0;
+  const Point b_order[3] = {b[0], reverse_b ? b[2] : b[1], reverse_b ? b[1] : b[2]};
+  const int b_order_side[3] = {b_side[0], reverse_b ? b_side[2] : b_side[1],
+                               reverse_b ? b_side[1] : b_side[2]};
+  const int j = alone(b_order_side);
+  const Point p2 = b_order[j], q2 = b_order[(j + 1) % 3], r2 = b_order[(j + 2) % 3];
+  if (b_order_side[j] < 0) std::swap(q1, r1);
+  return orient3d(p1, q1, p2, q2) <= 0 && orient3d(p1, r1, p2, r2) >= 0;
+}
+
 // No shared corner: any common point.
 bool triangles_meet(const Point a[3], const Point b[3]) {
   int b_side[3];  // b's corners against a's plane
@@ -116,6 +145,9 @@ bool triangles_meet(const Point a[3], const Point b[3]) {
   int a_side[3];
   for (int k = 0; k < 3; ++k) a_side[k] = orient3d(b[0], b[1], b[2], a[k]);
   if (strictly_one_side(a_side)) return false;
+  if (a_side[0] * a_side[1] * a_side[2] != 0 && b_side[0] * b_side[1] * b_side[2] != 0) {
+    return straddling_triangles_meet(a, a_side, b, b_side);
+  }
   for (int e = 0; e < 3; ++e) {
     const int f = (e + 1) % 3;
     if (segment_meets_triangle(a[e], a[f], a_side[e], a_side[f], b)) return true;
@@ -185,9 +217,14 @@ bool triangles_cross(const Vec3 a[3], const Vec3 b[3]) {
 }
 
 bool triangles_cross(const Vec3f a[3], const Vec3f b[3]) {
-  const Vec3 a_double[3] = {Vec3(a[0]), Vec3(a[1]), Vec3(a[2])};
-  const Vec3 b_double[3] = {Vec3(b[0]), Vec3(b[1]), Vec3(b[2])};
-  return triangles_cross(a_double, b_double);
+  double a_xyz[3][3], b_xyz[3][3];
+  for (int k = 0; k < 3; ++k) {
+    a_xyz[k][0] = a[k].x, a_xyz[k][1] = a[k].y, a_xyz[k][2] = a[k].z;
+    b_xyz[k][0] = b[k].x, b_xyz[k][1] = b[k].y, b_xyz[k][2] = b[k].z;
+  }
+  const double* const a_corners[3] = {a_xyz[0], a_xyz[1], a_xyz[2]};
+  const double* const b_corners[3] = {b_xyz[0], b_xyz[1], b_xyz[2]};
+  return triangles_cross(a_corners, b_corners);
 }
 
 }  // namespace g2s

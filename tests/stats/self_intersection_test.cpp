@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -353,6 +354,60 @@ TEST(TrianglesCross, SymmetricOnRandomSmallIntegerTriangles) {
   }
   EXPECT_GT(crossing, tested / 10);
   EXPECT_LT(crossing, tested);
+}
+
+TEST(TrianglesCross, StraddlingPairsAgreeWithTheirSegmentsOnTheCommonLine) {
+  // Pairs where each triangle has one corner on one side of the other's plane and two on the
+  // other (the test's interval path): each meets the other's plane in a segment of the planes'
+  // common line, and they cross exactly when the segments overlap. The segments are computed
+  // here in floating point and only clear cases (gaps and margins over 1e-9) are compared.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> coordinate(-1, 1);
+  int crossing = 0, apart = 0;
+  for (int trial = 0; trial < 200000; ++trial) {
+    Corners t[2];
+    for (auto& tri : t) {
+      for (auto& v : tri) v = Vec3(coordinate(rng), coordinate(rng), coordinate(rng));
+    }
+    const Vec3 n[2] = {g2s::cross(t[0][1] - t[0][0], t[0][2] - t[0][0]),
+                       g2s::cross(t[1][1] - t[1][0], t[1][2] - t[1][0])};
+    const Vec3 line = g2s::cross(n[0], n[1]);
+    if (norm(n[0]) < 1e-3 || norm(n[1]) < 1e-3 || norm(line) < 1e-3) continue;
+    double lo[2], hi[2];
+    bool clear = true;
+    for (int s = 0; s < 2 && clear; ++s) {
+      const Corners& own = t[s];
+      const Vec3& other_normal = n[1 - s];
+      const Vec3& other_corner = t[1 - s][0];
+      double height[3];
+      int above = 0;
+      for (int k = 0; k < 3; ++k) {
+        height[k] = dot(own[k] - other_corner, other_normal) / norm(other_normal);
+        clear = clear && std::abs(height[k]) > 1e-9;
+        above += height[k] > 0;
+      }
+      clear = clear && above != 0 && above != 3;
+      lo[s] = std::numeric_limits<double>::infinity();
+      hi[s] = -lo[s];
+      for (int k = 0; k < 3 && clear; ++k) {
+        const int l = (k + 1) % 3;
+        if ((height[k] > 0) == (height[l] > 0)) continue;
+        const Vec3 cut = own[k] + (own[l] - own[k]) * (height[k] / (height[k] - height[l]));
+        lo[s] = std::min(lo[s], dot(cut, line));
+        hi[s] = std::max(hi[s], dot(cut, line));
+      }
+    }
+    if (!clear) continue;
+    const double gap = std::max(lo[0], lo[1]) - std::min(hi[0], hi[1]);
+    if (std::abs(gap) < 1e-9) continue;
+    const bool expected = gap < 0;
+    (expected ? crossing : apart) += 1;
+    ASSERT_EQ(cross(t[0], t[1]), expected) << trial;
+    ASSERT_EQ(cross(t[1], t[0]), expected) << trial;
+    ASSERT_EQ(cross(t[0], {t[1][0], t[1][2], t[1][1]}), expected) << trial;
+  }
+  EXPECT_GT(crossing, 1000);
+  EXPECT_GT(apart, 1000);
 }
 
 // ---- Counts of compute_stats ----
