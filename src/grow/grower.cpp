@@ -303,7 +303,9 @@ class Grower {
   // than one fan left to a single one, with the holes that leaves filled in turn
   // (docs/algorithm.md, "No crossing triangles" and "Hole filling"). Filling first lets a hole
   // between two fans of a point join them, where deleting one fan would leave a larger hole.
-  // Last, scraps of surface near the rest go (remove_scraps).
+  // Then scraps of surface near the rest go (remove_scraps), and last a piece whose only border
+  // is a short loop is closed with a point left over, where that makes a closed surface
+  // (cap_single_loops).
   void finish_surface() {
     compact(remove_crossings());
     if (options_.max_hole_edges < 3) return;
@@ -328,6 +330,7 @@ class Grower {
       fill_small_holes();
     }
     if (options_.max_hole_rings > 0) remove_scraps();
+    cap_single_loops();
   }
 
   // Removes the pieces of surface that have no interior point (a lone triangle, a strip: every
@@ -363,6 +366,160 @@ class Grower {
       any = any || dead[t];
     }
     if (any) compact(std::move(dead));
+  }
+
+  // Closes each piece of surface whose only border is one loop of at most max_hole_edges edges
+  // with a fan from the loop to a point no triangle uses: a small closed object on its own that
+  // the front could not finish, such as the four points of a tetrahedron, whose fourth point
+  // lies behind the seed triangle, where no search ball looks (growth looking behind the front
+  // would fold fronts between the layers of a noisy scan). Hole filling leaves such a loop open:
+  // it is the piece's outer border, and closing it over its own points would turn a patch into
+  // a shell. A fan that closes the piece can block no later triangle. It chooses a point, as
+  // growth does, so growth's tests apply (fan_fits: nothing inside a fan triangle's smallest
+  // ball, no fold beyond max_fold), and hole filling's (fill_fits: no crossing, no repeat, no
+  // context point in the ball); it faces as the piece does. The piece and the point must stand
+  // apart from every other piece: on a noisy scan, a lone triangle in the layer beside the sheet
+  // and a noise point behind it pass the other tests.
+  void cap_single_loops() {
+    const auto n = static_cast<std::uint32_t>(grid_.size());
+    const auto max_edges =
+        static_cast<std::uint32_t>(std::min(options_.max_hole_edges, MeshOptions::kMaxHoleEdges));
+    std::vector<std::uint32_t> piece = pieces();
+    // Per piece: its open edges, or kNoIndex where it cannot be capped: a point with other than
+    // two open edges (two loops, or one through a point twice), a point the run does not judge,
+    // or a triangle loaded before the run.
+    std::vector<std::uint32_t> open_edges(n, 0), ends(n, 0);
+    edges_.for_each_open([&](Index u, Index v) {
+      ++open_edges[piece[u]];
+      ++ends[u];
+      ++ends[v];
+    });
+    const auto exclude = [&](Index v) { open_edges[piece[v]] = kNoIndex; };
+    for (std::uint32_t v = 0; v < n; ++v) {
+      if (piece[v] != kNoIndex && (!fillable(v) || (ends[v] != 0 && ends[v] != 2))) exclude(v);
+    }
+    for (std::size_t t = 0; t < preloaded_; ++t) exclude(triangles_[t][0]);
+    const auto cappable = [&](std::uint32_t root) {
+      return open_edges[root] >= 3 && open_edges[root] <= max_edges;
+    };
+    // The open edges of those pieces as their triangles face, by the point they leave.
+    std::vector<OpenEdge> open;
+    for (std::uint32_t t = 0; t < triangles_.size(); ++t) {
+      if (!cappable(piece[triangles_[t][0]])) continue;
+      const Triangle tri = facing(t);
+      for (int k = 0; k < 3; ++k) {
+        if (triangles_on(tri[k], tri[(k + 1) % 3]) == 1)
+          open.push_back({tri[k], tri[(k + 1) % 3], t});
+      }
+    }
+    std::sort(open.begin(), open.end(),
+              [](const OpenEdge& a, const OpenEdge& b) { return a.from < b.from; });
+    const auto leaving = [&](Index v) {
+      const auto it = std::lower_bound(open.begin(), open.end(), v,
+                                       [](const OpenEdge& e, Index from) { return e.from < from; });
+      return it != open.end() && it->from == v ? &*it : nullptr;
+    };
+    // A small object stands apart: no point of another piece within kMaxLeftOutDistance
+    // spacings (nearer, a piece is the noise of that surface, as scraps are).
+    const double apart = kMaxLeftOutDistance * grid_.spacing();
+    const auto stands_apart = [&](Index v, std::uint32_t root) {
+      bool alone = true;
+      grid_.for_each_in_ball(grid_.position(v), apart, [&](std::uint32_t j, double) {
+        alone = alone && (piece[j] == kNoIndex || piece[j] == root);
+      });
+      return alone;
+    };
+    std::optional<detail::TriangleCells> cells;
+    std::vector<Index> loop;
+    std::vector<std::uint32_t> outside;
+    std::vector<std::pair<double, Index>> candidates;
+    std::vector<Triangle> fan;
+    for (const OpenEdge& start : open) {
+      const std::uint32_t root = piece[start.from];
+      if (!cappable(root)) continue;
+      const std::uint32_t length = open_edges[root];
+      open_edges[root] = kNoIndex;  // each piece once
+      loop.clear();
+      outside.clear();
+      const OpenEdge* e = &start;
+      do {
+        loop.push_back(e->from);
+        outside.push_back(e->triangle);
+        e = leaving(e->to);
+      } while (e != nullptr && e != &start && loop.size() < length);
+      if (e != &start || loop.size() != length) continue;  // not one loop as the piece faces
+      if (!std::all_of(loop.begin(), loop.end(), [&](Index v) { return stands_apart(v, root); })) {
+        continue;
+      }
+      // The points no triangle uses near the loop, nearest its centre first.
+      Vec3 centre{0, 0, 0};
+      for (const Index v : loop) centre = centre + grid_.position(v);
+      centre = centre * (1.0 / static_cast<double>(loop.size()));
+      candidates.clear();
+      grid_.for_each_in_ball(centre, radius_cap_, [&](std::uint32_t j, double d2) {
+        if (piece[j] == kNoIndex && fillable(j)) candidates.push_back({d2, j});
+      });
+      std::sort(candidates.begin(), candidates.end());
+      for (const auto& [d2, p] : candidates) {
+        if (!stands_apart(p, root) || !fan_fits(loop, outside, p, cells, fan)) continue;
+        // The triangles around face consistently along the loop: their groups become one.
+        const std::uint32_t group = group_[outside.front()];
+        for (const std::uint32_t t : outside) {
+          groups_.unite(groups_.find(group).first, groups_.find(group_[t]).first, 0);
+        }
+        const std::uint8_t flip = groups_.find(group).second;
+        for (const Triangle& t : fan) {
+          const auto id = static_cast<std::uint32_t>(triangles_.size());
+          triangles_.push_back(t);
+          group_.push_back(group);
+          flip_.push_back(flip);
+          for (int k = 0; k < 3; ++k) edges_.add(t[k], t[(k + 1) % 3], id);
+        }
+        piece[p] = root;
+        cells.reset();  // it holds the triangles as they were
+        break;
+      }
+    }
+  }
+
+  // Whether the fan from `loop` (its edges loop[i] -> loop[i+1] as the triangles outside them,
+  // `outside`, face) to point p passes growth's tests: no point strictly inside a fan
+  // triangle's smallest ball (the Gabriel test, with the seeds' tolerance) and no fold beyond
+  // max_fold from its neighbours, in the fan and across the loop; and hole filling's
+  // (fill_fits). The fan goes to `fan`.
+  bool fan_fits(std::span<const Index> loop, std::span<const std::uint32_t> outside, Index p,
+                std::optional<detail::TriangleCells>& cells, std::vector<Triangle>& fan) {
+    fan.clear();
+    const Vec3 c = grid_.position(p);
+    Vec3 first{0, 0, 0}, previous{0, 0, 0};
+    for (std::size_t i = 0; i < loop.size(); ++i) {
+      const Index u = loop[i], v = loop[(i + 1) % loop.size()];
+      const Vec3 a = grid_.position(u), b = grid_.position(v);
+      Ball ball;
+      if (!circumball(b, a, c, ball)) return false;
+      const Vec3 normal = normalized(cross(a - b, c - b));
+      if (dot(normal, facing_normal(outside[i])) < cos_max_fold_) return false;
+      if (i > 0 && dot(normal, previous) < cos_max_fold_) return false;
+      if (i == 0) first = normal;
+      previous = normal;
+      bool empty = true;
+      grid_.for_each_in_ball(ball.centre, std::sqrt(ball.radius2), [&](std::uint32_t j, double d2) {
+        empty = empty && (j == u || j == v || j == p || d2 >= ball.radius2 * (1 - 1e-6));
+      });
+      if (!empty) return false;
+      fan.push_back({v, u, p});
+    }
+    if (dot(first, previous) < cos_max_fold_) return false;
+    // The live triangles near the fan, for fill_fits.
+    if (!cells) cells.emplace(grid_.points(), std::span<const Triangle>(triangles_));
+    detail::Box box{grid_.point(p), grid_.point(p)};
+    for (const Index v : loop) box = detail::enclose(box, grid_.point(v));
+    loop_near_.clear();
+    last_blocker_ = kNoIndex;
+    cells->for_each_near(box.lo, box.hi, [&](std::uint32_t other, const detail::Box& near_box) {
+      loop_near_.push_back({other, near_box, {{}, kBallUnknown}});
+    });
+    return std::all_of(fan.begin(), fan.end(), [&](const Triangle& t) { return fill_fits(t); });
   }
 
   // Per point, the surface piece it is a corner of (a representative point of it: the triangles

@@ -1,7 +1,8 @@
 // The grower's gap closing (src/grow/grower.cpp, close_three_edge_gaps) on a hand-made front:
 // three kept triangles around a triangular gap, with a context point in the gap that is every
 // gap edge's Gabriel point but may not join, so the front itself leaves the gap open. And the
-// removal of scraps (remove_scraps): a lone triangle near a flat patch, and one far from it.
+// removal of scraps (remove_scraps): a lone triangle near a flat patch, and one far from it. And
+// the cap that closes a piece's only loop with a point left over (cap_single_loops).
 #include "grow/grower.hpp"
 
 #include <gtest/gtest.h>
@@ -9,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "grid/hash_grid.hpp"
@@ -152,4 +154,51 @@ TEST(Scraps, ALoneTriangleNearTheSurfaceGoesAndItsPointsAreLeftOut) {
 
 TEST(Scraps, ALoneTriangleFarFromTheSurfaceStays) {
   EXPECT_TRUE(has_lone_triangle(grow_patch_with_lone_triangle(6.0f, 3)));
+}
+
+// Capping a piece's only loop (cap_single_loops): the four corners of a regular tetrahedron.
+// Returns the grown triangles (input indices) as they face once their flips are applied.
+std::vector<Triangle> grow_tetrahedron(const g2s::MeshOptions& options) {
+  const std::vector<float> xyz{1, 1, 1, 1, -1, -1, -1, 1, -1, -1, -1, 1};
+  const std::vector<Index> ids{0, 1, 2, 3};
+  const g2s::HashGrid grid(xyz, ids);
+  const g2s::GrowResult r = g2s::grow_mesh(grid, options);
+  std::vector<Triangle> out;
+  for (std::size_t t = 0; t < r.triangles.size(); ++t) {
+    Triangle tri{grid.id(r.triangles[t][0]), grid.id(r.triangles[t][1]),
+                 grid.id(r.triangles[t][2])};
+    if (r.flip[t]) std::swap(tri[1], tri[2]);
+    out.push_back(tri);
+  }
+  return out;
+}
+
+TEST(Caps, TheFrontGrowsOneTriangleOfATetrahedron) {
+  // Without hole filling nothing is capped: the fourth point lies behind the seed triangle,
+  // where no search ball looks.
+  g2s::MeshOptions options;
+  options.max_hole_edges = 0;
+  EXPECT_EQ(grow_tetrahedron(options).size(), 1u);
+}
+
+TEST(Caps, TheFourthPointClosesTheTetrahedronConsistentlyOriented) {
+  const std::vector<Triangle> triangles = grow_tetrahedron(g2s::MeshOptions{});
+  ASSERT_EQ(triangles.size(), 4u);
+  // Closed and consistently oriented: every directed edge once, and its reverse once.
+  std::vector<std::pair<Index, Index>> directed;
+  for (const Triangle& t : triangles) {
+    for (int k = 0; k < 3; ++k) directed.push_back({t[k], t[(k + 1) % 3]});
+  }
+  std::sort(directed.begin(), directed.end());
+  EXPECT_EQ(std::adjacent_find(directed.begin(), directed.end()), directed.end());
+  for (const auto& [u, v] : directed) {
+    EXPECT_TRUE(std::binary_search(directed.begin(), directed.end(), std::pair{v, u}));
+  }
+}
+
+TEST(Caps, NoCapFoldsBeyondMaxFold) {
+  // The regular tetrahedron's neighbouring faces' normals are 109.5 degrees apart.
+  g2s::MeshOptions options;
+  options.max_fold_deg = 100;
+  EXPECT_EQ(grow_tetrahedron(options).size(), 1u);
 }

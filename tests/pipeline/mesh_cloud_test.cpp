@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <functional>
+#include <numbers>
 #include <numeric>
 #include <random>
 #include <string>
@@ -277,6 +278,39 @@ TEST(Mesher, ThreePointsInGeneralPositionGiveOneTriangle) {
   const PipelineMesh mesh = g2s::mesh_cloud(cloud);
   ASSERT_EQ(mesh.triangles.size(), 1u);
   EXPECT_EQ(canonical_set(mesh.triangles), (std::vector<Triangle>{{0, 1, 2}}));  // faces +z
+}
+
+// A small closed point set: the front grows what lies ahead of it, and the fan from the open
+// loop to the point left over closes the rest (docs/algorithm.md §3, "A piece's only loop,
+// capped"). Closed, no defect, every face once, facing outward.
+void expect_closed_polyhedron(const PointCloud& cloud, const std::vector<Triangle>& faces,
+                              const std::string& name) {
+  const PipelineMesh mesh = g2s::mesh_cloud(cloud);
+  const MeshStats s = stats_of(cloud, mesh.triangles);
+  expect_manifold(s, name);
+  EXPECT_EQ(s.boundary_edges, 0u) << name;
+  EXPECT_EQ(s.crossing_pairs, 0u) << name;
+  EXPECT_EQ(s.components, 1u) << name;
+  EXPECT_EQ(canonical_set(mesh.triangles), canonical_set(faces)) << name;
+  EXPECT_GT(signed_volume(cloud, mesh.triangles), 0) << name << ": faces inward";
+}
+
+TEST(Mesher, FourPointsOfATetrahedronGiveTheClosedTetrahedronFacingOutward) {
+  // Once one triangle is grown, the fourth point lies behind it, where no search ball looks.
+  const PointCloud regular = from_points({{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}});
+  expect_closed_polyhedron(regular, {{0, 1, 2}, {0, 3, 1}, {0, 2, 3}, {1, 3, 2}}, "regular");
+  const PointCloud irregular =
+      from_points({{0, 0, 0}, {3, 0.2, 0.1}, {0.5, 2.5, -0.3}, {1.1, 0.9, 2.2}});
+  expect_closed_polyhedron(irregular, {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}, "irregular");
+}
+
+TEST(Mesher, FivePointsOfATriangularBipyramidGiveItsSixFaces) {
+  // The front grows two faces across one equator edge; the third equator point closes the rest.
+  const double c = std::cos(2 * std::numbers::pi / 3), s = std::sin(2 * std::numbers::pi / 3);
+  const PointCloud cloud =
+      from_points({{1, 0, 0}, {c, s, 0}, {c, -s, 0}, {0, 0, 1.2}, {0, 0, -1.2}});
+  expect_closed_polyhedron(
+      cloud, {{0, 1, 3}, {1, 2, 3}, {2, 0, 3}, {0, 4, 1}, {1, 4, 2}, {2, 4, 0}}, "bipyramid");
 }
 
 TEST(Mesher, AllPointsIdenticalGiveNoTriangles) {
