@@ -399,6 +399,20 @@ class Grower {
       if (piece[v] != kNoIndex && (!fillable(v) || (ends[v] != 0 && ends[v] != 2))) exclude(v);
     }
     for (std::size_t t = 0; t < preloaded_; ++t) exclude(triangles_[t][0]);
+    // A cloud meshed whole as one piece with one point left over (all fillable): the fan to
+    // that point is the only way to close it.
+    std::uint32_t left_over = 0, first_root = kNoIndex;
+    bool one_piece = preloaded_ == 0;
+    for (std::uint32_t v = 0; v < n && one_piece; ++v) {
+      one_piece = fillable(v);
+      if (piece[v] == kNoIndex) {
+        ++left_over;
+      } else {
+        if (first_root == kNoIndex) first_root = piece[v];
+        one_piece = one_piece && piece[v] == first_root;
+      }
+    }
+    const bool only_point = one_piece && left_over == 1;
     const auto cappable = [&](std::uint32_t root) {
       return open_edges[root] >= 3 && open_edges[root] <= max_edges;
     };
@@ -461,7 +475,9 @@ class Grower {
       });
       std::sort(candidates.begin(), candidates.end());
       for (const auto& [d2, p] : candidates) {
-        if (!stands_apart(p, root) || !fan_fits(loop, outside, p, cells, fan)) continue;
+        if (!stands_apart(p, root) || !fan_fits(loop, outside, p, piece, only_point, cells, fan)) {
+          continue;
+        }
         // The triangles around face consistently along the loop: their groups become one.
         const std::uint32_t group = group_[outside.front()];
         for (const std::uint32_t t : outside) {
@@ -483,12 +499,18 @@ class Grower {
   }
 
   // Whether the fan from `loop` (its edges loop[i] -> loop[i+1] as the triangles outside them,
-  // `outside`, face) to point p passes growth's tests: no point strictly inside a fan
-  // triangle's smallest ball (the Gabriel test, with the seeds' tolerance) and no fold beyond
-  // max_fold from its neighbours, in the fan and across the loop; and hole filling's
-  // (fill_fits). The fan goes to `fan`.
+  // `outside`, face) to point p passes growth's tests: no point no triangle uses strictly inside
+  // a fan triangle's smallest ball (the Gabriel test among the points the fan could take, with
+  // the seeds' tolerance; the piece's own corners may lie inside, as the fourth corner of a
+  // tetrahedron whose face is not a Gabriel triangle does) and no fold beyond max_fold from its
+  // neighbours, in the fan and across the loop; and hole filling's (fill_fits). `piece` says
+  // which points a triangle uses (pieces()). With `only_point` (p is the one point of the run
+  // left over, the rest one piece) the fan has no choice of point, and as a hole's filling it
+  // is held to no fold limit. The fan goes to `fan`.
   bool fan_fits(std::span<const Index> loop, std::span<const std::uint32_t> outside, Index p,
+                std::span<const std::uint32_t> piece, bool only_point,
                 std::optional<detail::TriangleCells>& cells, std::vector<Triangle>& fan) {
+    const double cos_max_fold = only_point ? -1 : cos_max_fold_;
     fan.clear();
     const Vec3 c = grid_.position(p);
     Vec3 first{0, 0, 0}, previous{0, 0, 0};
@@ -498,18 +520,18 @@ class Grower {
       Ball ball;
       if (!circumball(b, a, c, ball)) return false;
       const Vec3 normal = normalized(cross(a - b, c - b));
-      if (dot(normal, facing_normal(outside[i])) < cos_max_fold_) return false;
-      if (i > 0 && dot(normal, previous) < cos_max_fold_) return false;
+      if (dot(normal, facing_normal(outside[i])) < cos_max_fold) return false;
+      if (i > 0 && dot(normal, previous) < cos_max_fold) return false;
       if (i == 0) first = normal;
       previous = normal;
       bool empty = true;
       grid_.for_each_in_ball(ball.centre, std::sqrt(ball.radius2), [&](std::uint32_t j, double d2) {
-        empty = empty && (j == u || j == v || j == p || d2 >= ball.radius2 * (1 - 1e-6));
+        empty = empty && (piece[j] != kNoIndex || j == p || d2 >= ball.radius2 * (1 - 1e-6));
       });
       if (!empty) return false;
       fan.push_back({v, u, p});
     }
-    if (dot(first, previous) < cos_max_fold_) return false;
+    if (dot(first, previous) < cos_max_fold) return false;
     // The live triangles near the fan, for fill_fits.
     if (!cells) cells.emplace(grid_.points(), std::span<const Triangle>(triangles_));
     detail::Box box{grid_.point(p), grid_.point(p)};
@@ -685,9 +707,19 @@ class Grower {
       close_loop(0, closed);
     }
     // A piece's longest loop is its outer border, not a hole: filling it would close a patch
-    // into a shell.
+    // into a shell. Unless one piece uses every point of the run, all of them fillable: then the
+    // cloud is one small object meshed whole (four points of a tetrahedron give two faces, the
+    // other two lying behind the front), and nothing else is there for its border to continue
+    // into; filling it closes the object, where the filling neither crosses nor repeats a face
+    // (a flat patch's filling would lie on the patch).
+    bool one_object = preloaded_ == 0 && !piece.empty();
+    for (std::uint32_t v = 0; v < piece.size() && one_object; ++v) {
+      one_object = piece[v] != kNoIndex && piece[v] == piece.front() && fillable(v);
+    }
     std::vector<std::uint32_t> longest(grid_.size(), 0);
-    for (const Loop& l : loops) longest[l.component] = std::max(longest[l.component], l.length);
+    if (!one_object) {
+      for (const Loop& l : loops) longest[l.component] = std::max(longest[l.component], l.length);
+    }
     // Which loops are holes, and where each open edge is, for holes that widen into others.
     HoleIndex holes{open, loop_edges, {}, {}, {}, {}, {}};
     holes.loop_of.resize(open.size());

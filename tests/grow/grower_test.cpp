@@ -156,11 +156,17 @@ TEST(Scraps, ALoneTriangleFarFromTheSurfaceStays) {
   EXPECT_TRUE(has_lone_triangle(grow_patch_with_lone_triangle(6.0f, 3)));
 }
 
-// Capping a piece's only loop (cap_single_loops): the four corners of a regular tetrahedron.
-// Returns the grown triangles (input indices) as they face once their flips are applied.
-std::vector<Triangle> grow_tetrahedron(const g2s::MeshOptions& options) {
-  const std::vector<float> xyz{1, 1, 1, 1, -1, -1, -1, 1, -1, -1, -1, 1};
-  const std::vector<Index> ids{0, 1, 2, 3};
+// Capping a piece's only loop (cap_single_loops): the four corners of a regular tetrahedron,
+// and with `far_point` a fifth point far from them (so that the run is more than the piece and
+// the point left over). Returns the grown triangles (input indices) as they face once their
+// flips are applied.
+std::vector<Triangle> grow_tetrahedron(const g2s::MeshOptions& options, bool far_point = false) {
+  std::vector<float> xyz{1, 1, 1, 1, -1, -1, -1, 1, -1, -1, -1, 1};
+  std::vector<Index> ids{0, 1, 2, 3};
+  if (far_point) {
+    xyz.insert(xyz.end(), {30, 30, 30});
+    ids.push_back(4);
+  }
   const g2s::HashGrid grid(xyz, ids);
   const g2s::GrowResult r = g2s::grow_mesh(grid, options);
   std::vector<Triangle> out;
@@ -196,9 +202,14 @@ TEST(Caps, TheFourthPointClosesTheTetrahedronConsistentlyOriented) {
   }
 }
 
-TEST(Caps, NoCapFoldsBeyondMaxFold) {
-  // The regular tetrahedron's neighbouring faces' normals are 109.5 degrees apart.
+TEST(Caps, NoCapThatChoosesAPointFoldsBeyondMaxFold) {
+  // The regular tetrahedron's neighbouring faces' normals are 109.5 degrees apart. With another
+  // point in the run the fan chooses its point, as growth does, under growth's fold limit.
   g2s::MeshOptions options;
   options.max_fold_deg = 100;
-  EXPECT_EQ(grow_tetrahedron(options).size(), 1u);
+  EXPECT_EQ(grow_tetrahedron(options, true).size(), 1u);
+  EXPECT_EQ(grow_tetrahedron(g2s::MeshOptions{}, true).size(), 4u);
+  // The tetrahedron alone: the point left over is the only one, and like a hole's filling the
+  // fan is held to no fold limit.
+  EXPECT_EQ(grow_tetrahedron(options).size(), 4u);
 }

@@ -313,6 +313,64 @@ TEST(Mesher, FivePointsOfATriangularBipyramidGiveItsSixFaces) {
       cloud, {{0, 1, 3}, {1, 2, 3}, {2, 0, 3}, {0, 4, 1}, {1, 4, 2}, {2, 4, 0}}, "bipyramid");
 }
 
+TEST(Mesher, RandomTetrahedraAreClosed) {
+  // Depending on its shape the front grows one, two or three faces of a tetrahedron before the
+  // rest lies behind it: the point left over is capped, or the loop over all four points is
+  // filled (one piece using every point: the cloud is one object).
+  using Point = std::array<double, 3>;
+  const auto minus = [](const Point& a, const Point& b) {
+    return Point{a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+  };
+  const auto triple = [](const Point& a, const Point& b, const Point& c) {  // a . (b x c)
+    return a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) +
+           a[2] * (b[0] * c[1] - b[1] * c[0]);
+  };
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> coordinate(-1, 1);
+  int tried = 0;
+  while (tried < 100) {
+    std::vector<Point> corners(4);
+    for (Point& c : corners) c = {coordinate(rng), coordinate(rng), coordinate(rng)};
+    // Well-shaped: some volume, no two corners close.
+    double shortest = 1e300;
+    for (int i = 0; i < 4; ++i) {
+      for (int j = i + 1; j < 4; ++j) {
+        const Point d = minus(corners[i], corners[j]);
+        shortest = std::min(shortest, std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
+      }
+    }
+    const double six_volume = triple(minus(corners[3], corners[0]), minus(corners[1], corners[0]),
+                                     minus(corners[2], corners[0]));
+    if (std::abs(six_volume) < 0.3 || shortest < 0.5) continue;
+    ++tried;
+    // The base 0, 1, 2 faces away from corner 3; each side traverses a base edge the other way.
+    const Triangle base = six_volume < 0 ? Triangle{0, 1, 2} : Triangle{0, 2, 1};
+    std::vector<Triangle> faces = {base};
+    for (int e = 0; e < 3; ++e) faces.push_back({base[(e + 1) % 3], base[e], 3});
+    expect_closed_polyhedron(from_points(corners), faces, "tetrahedron " + std::to_string(tried));
+  }
+}
+
+TEST(Mesher, SquarePyramidIsClosedAndAFlatQuadStaysOpen) {
+  // The front grows the four sides around the apex; one piece then uses all five points, and its
+  // base loop is filled.
+  const PointCloud pyramid =
+      from_points({{1, 1, 0}, {1, -1, 0}, {-1, -1, 0}, {-1, 1, 0}, {0, 0, 1.4}});
+  const PipelineMesh closed = g2s::mesh_cloud(pyramid);
+  const MeshStats s = stats_of(pyramid, closed.triangles);
+  expect_manifold(s, "pyramid");
+  EXPECT_EQ(closed.triangles.size(), 6u);
+  EXPECT_EQ(s.boundary_edges, 0u);
+  EXPECT_EQ(s.crossing_pairs, 0u);
+  EXPECT_GT(signed_volume(pyramid, closed.triangles), 0) << "faces inward";
+  // Four points in one plane: the filling would lie on the two triangles, so the quad stays a
+  // patch.
+  const PointCloud quad = from_points({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}});
+  const PipelineMesh open = g2s::mesh_cloud(quad);
+  EXPECT_EQ(open.triangles.size(), 2u);
+  EXPECT_EQ(stats_of(quad, open.triangles).boundary_edges, 4u);
+}
+
 TEST(Mesher, AllPointsIdenticalGiveNoTriangles) {
   PointCloud cloud;
   for (int i = 0; i < 1000; ++i) cloud.xyz.insert(cloud.xyz.end(), {4.5, -1.25, 3.0});
