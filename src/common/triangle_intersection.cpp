@@ -157,8 +157,11 @@ bool triangles_meet(const Point a[3], const Point b[3]) {
 }
 
 // One shared corner, a[0] == b[0]: a common point other than it.
+// A triangle whose other two corners lie strictly on one side of the other's plane meets that
+// plane, and so the other triangle, only in the shared corner.
 bool triangles_meet_beyond_corner(const Point a[3], const Point b[3]) {
   const int a1 = orient3d(b[0], b[1], b[2], a[1]), a2 = orient3d(b[0], b[1], b[2], a[2]);
+  if (a1 * a2 > 0) return false;
   if (segment_meets_triangle(a[1], a[2], a1, a2, b)) return true;
   const int b1 = orient3d(a[0], a[1], a[2], b[1]), b2 = orient3d(a[0], a[1], a[2], b[2]);
   return segment_meets_triangle(b[1], b[2], b1, b2, a);
