@@ -32,9 +32,10 @@ struct MeshOptions {
   // Once growth is over, close every hole whose boundary loop has at most this many edges with
   // triangles over the loop's own points, where the result stays manifold, consistently
   // oriented and free of crossings (docs/algorithm.md, "Hole filling"). Small objects are
-  // closed too: a piece using every point of the run has its outer border filled, and a piece
-  // whose only border is such a loop is capped by a fan to a point no triangle uses (a
-  // tetrahedron's four points give its four faces; "Small objects closed"). 0: none. At most
+  // closed too: a piece using every point of the run, at most one of them inside it, has its
+  // outer border filled, and a piece whose only border is such a loop is capped by a fan to a
+  // point no triangle uses (a tetrahedron's four points give its four faces; "Small objects
+  // closed"). 0: none. At most
   // kMaxHoleEdges counts (a loop of n edges costs O(n^3) memory and O(n^4) time to fill).
   int max_hole_edges = 30;
   static constexpr int kMaxHoleEdges = 100;

@@ -707,15 +707,20 @@ class Grower {
       close_loop(0, closed);
     }
     // A piece's longest loop is its outer border, not a hole: filling it would close a patch
-    // into a shell. Unless one piece uses every point of the run, all of them fillable: then the
-    // cloud is one small object meshed whole (four points of a tetrahedron give two faces, the
-    // other two lying behind the front), and nothing else is there for its border to continue
-    // into; filling it closes the object, where the filling neither crosses nor repeats a face
-    // (a flat patch's filling would lie on the patch).
+    // into a shell. Unless the cloud is a few corners of one small object: one piece uses every
+    // point of the run (all of them fillable) and at most one of them is inside it, off every
+    // loop (four points of a tetrahedron give two faces, or three around one corner, the rest
+    // lying behind the front). A sampled patch, even a small curved one, has points inside its
+    // border. Then nothing else is there for the border to continue into, and filling it closes
+    // the object, where the filling neither crosses nor repeats a face (a flat quad's filling
+    // would lie on it).
     bool one_object = preloaded_ == 0 && !piece.empty();
+    std::uint32_t inside = 0;
     for (std::uint32_t v = 0; v < piece.size() && one_object; ++v) {
       one_object = piece[v] != kNoIndex && piece[v] == piece.front() && fillable(v);
+      inside += on_open[v] == 0;
     }
+    one_object = one_object && inside <= 1;
     std::vector<std::uint32_t> longest(grid_.size(), 0);
     if (!one_object) {
       for (const Loop& l : loops) longest[l.component] = std::max(longest[l.component], l.length);

@@ -363,6 +363,16 @@ TEST(Mesher, SquarePyramidIsClosedAndAFlatQuadStaysOpen) {
   EXPECT_EQ(s.boundary_edges, 0u);
   EXPECT_EQ(s.crossing_pairs, 0u);
   EXPECT_GT(signed_volume(pyramid, closed.triangles), 0) << "faces inward";
+  // A small sampled cap (points inside its border) stays an open patch.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> coordinate(-0.5, 0.5);
+  std::vector<std::array<double, 3>> cap;
+  for (int i = 0; i < 30; ++i) {
+    const double x = coordinate(rng), y = coordinate(rng);
+    cap.push_back({x, y, 1 - std::sqrt(1 - x * x - y * y)});
+  }
+  const PointCloud cap_cloud = from_points(cap);
+  EXPECT_GT(stats_of(cap_cloud, g2s::mesh_cloud(cap_cloud).triangles).boundary_edges, 0u);
   // Four points in one plane: the filling would lie on the two triangles, so the quad stays a
   // patch.
   const PointCloud quad = from_points({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}});
