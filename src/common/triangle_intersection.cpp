@@ -208,7 +208,10 @@ bool triangles_cross(const double* const a[3], const double* const b[3]) {
   }
 }
 
-bool triangles_cross(const Vec3 a[3], const Vec3 b[3]) {
+namespace {
+// The test on corners of any 3-vector type, converted to double in one step.
+template <class Corner>
+bool cross_in_double(const Corner a[3], const Corner b[3]) {
   double a_xyz[3][3], b_xyz[3][3];
   for (int k = 0; k < 3; ++k) {
     a_xyz[k][0] = a[k].x, a_xyz[k][1] = a[k].y, a_xyz[k][2] = a[k].z;
@@ -218,16 +221,14 @@ bool triangles_cross(const Vec3 a[3], const Vec3 b[3]) {
   const double* const b_corners[3] = {b_xyz[0], b_xyz[1], b_xyz[2]};
   return triangles_cross(a_corners, b_corners);
 }
+}  // namespace
+
+bool triangles_cross(const Vec3 a[3], const Vec3 b[3]) {
+  return cross_in_double(a, b);
+}
 
 bool triangles_cross(const Vec3f a[3], const Vec3f b[3]) {
-  double a_xyz[3][3], b_xyz[3][3];
-  for (int k = 0; k < 3; ++k) {
-    a_xyz[k][0] = a[k].x, a_xyz[k][1] = a[k].y, a_xyz[k][2] = a[k].z;
-    b_xyz[k][0] = b[k].x, b_xyz[k][1] = b[k].y, b_xyz[k][2] = b[k].z;
-  }
-  const double* const a_corners[3] = {a_xyz[0], a_xyz[1], a_xyz[2]};
-  const double* const b_corners[3] = {b_xyz[0], b_xyz[1], b_xyz[2]};
-  return triangles_cross(a_corners, b_corners);
+  return cross_in_double(a, b);
 }
 
 }  // namespace g2s
