@@ -375,9 +375,10 @@ class Grower {
   // would fold fronts between the layers of a noisy scan). Hole filling leaves such a loop open:
   // it is the piece's outer border, and closing it over its own points would turn a patch into
   // a shell. A fan that closes the piece can block no later triangle. It chooses a point, as
-  // growth does, so growth's tests apply (fan_fits: nothing inside a fan triangle's smallest
-  // ball, no fold beyond max_fold), and hole filling's (fill_fits: no crossing, no repeat, no
-  // context point in the ball); it faces as the piece does. The piece and the point must stand
+  // growth does, so growth's tests apply (fan_fits: no unused point inside a fan triangle's
+  // smallest ball, no fold beyond max_fold unless the point is the run's last), and hole
+  // filling's (fill_fits: no crossing, no repeat, no context point in the ball); it faces as
+  // the piece does. The piece and the point must stand
   // apart from every other piece: on a noisy scan, a lone triangle in the layer beside the sheet
   // and a noise point behind it pass the other tests.
   void cap_single_loops() {
