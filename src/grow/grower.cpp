@@ -400,20 +400,10 @@ class Grower {
       if (piece[v] != kNoIndex && (!fillable(v) || (ends[v] != 0 && ends[v] != 2))) exclude(v);
     }
     for (std::size_t t = 0; t < preloaded_; ++t) exclude(triangles_[t][0]);
-    // A cloud meshed whole as one piece with one point left over (all fillable): the fan to
-    // that point is the only way to close it.
-    std::uint32_t left_over = 0, first_root = kNoIndex;
-    bool one_piece = preloaded_ == 0;
-    for (std::uint32_t v = 0; v < n && one_piece; ++v) {
-      one_piece = fillable(v);
-      if (piece[v] == kNoIndex) {
-        ++left_over;
-      } else {
-        if (first_root == kNoIndex) first_root = piece[v];
-        one_piece = one_piece && piece[v] == first_root;
-      }
-    }
-    const bool only_point = one_piece && left_over == 1;
+    // A cloud meshed whole as one piece with one point left over: the fan to that point is the
+    // only way to close it.
+    std::uint32_t unused = 0;
+    const bool only_point = one_piece(piece, unused) && unused == 1;
     const auto cappable = [&](std::uint32_t root) {
       return open_edges[root] >= 3 && open_edges[root] <= max_edges;
     };
@@ -479,12 +469,7 @@ class Grower {
         if (!stands_apart(p, root) || !fan_fits(loop, outside, p, piece, only_point, cells, fan)) {
           continue;
         }
-        // The triangles around face consistently along the loop: their groups become one.
-        const std::uint32_t group = group_[outside.front()];
-        for (const std::uint32_t t : outside) {
-          groups_.unite(groups_.find(group).first, groups_.find(group_[t]).first, 0);
-        }
-        const std::uint8_t flip = groups_.find(group).second;
+        const auto [group, flip] = join_groups(outside);
         for (const Triangle& t : fan) {
           const auto id = static_cast<std::uint32_t>(triangles_.size());
           triangles_.push_back(t);
@@ -497,6 +482,48 @@ class Grower {
         break;
       }
     }
+  }
+
+  // The triangles around a loop (`outside`, one per edge) face consistently along it: their
+  // orientation groups become one, as they face now. Returns that group and its flip, for the
+  // triangles that close the loop.
+  std::pair<std::uint32_t, std::uint8_t> join_groups(std::span<const std::uint32_t> outside) {
+    const std::uint32_t group = group_[outside.front()];
+    for (const std::uint32_t t : outside) {
+      groups_.unite(groups_.find(group).first, groups_.find(group_[t]).first, 0);
+    }
+    return {group, groups_.find(group).second};
+  }
+
+  // Whether one piece uses every point of the run that some triangle uses, every point is one
+  // the run judges and no triangle was loaded before it (the run is one small object meshed
+  // whole, or a scan's tile: only the former passes with few points left over); `unused` counts
+  // the points no triangle uses. `piece` as pieces() gives it.
+  bool one_piece(std::span<const std::uint32_t> piece, std::uint32_t& unused) const {
+    unused = 0;
+    std::uint32_t root = kNoIndex;
+    for (std::uint32_t v = 0; v < piece.size(); ++v) {
+      if (!fillable(v)) return false;
+      if (piece[v] == kNoIndex) {
+        ++unused;
+      } else if (root == kNoIndex) {
+        root = piece[v];
+      } else if (piece[v] != root) {
+        return false;
+      }
+    }
+    return preloaded_ == 0 && root != kNoIndex;
+  }
+
+  // Lists the grown triangles whose boxes overlap `box` in loop_near_ (their balls not yet
+  // computed), but those `skip` says, for fill_fits.
+  template <class Skip>
+  void gather_near(const detail::TriangleCells& cells, const detail::Box& box, Skip&& skip) {
+    loop_near_.clear();
+    last_blocker_ = kNoIndex;
+    cells.for_each_near(box.lo, box.hi, [&](std::uint32_t other, const detail::Box& near_box) {
+      if (!skip(other)) loop_near_.push_back({other, near_box, {{}, kBallUnknown}});
+    });
   }
 
   // Whether the fan from `loop` (its edges loop[i] -> loop[i+1] as the triangles outside them,
@@ -537,11 +564,7 @@ class Grower {
     if (!cells) cells.emplace(grid_.points(), std::span<const Triangle>(triangles_));
     detail::Box box{grid_.point(p), grid_.point(p)};
     for (const Index v : loop) box = detail::enclose(box, grid_.point(v));
-    loop_near_.clear();
-    last_blocker_ = kNoIndex;
-    cells->for_each_near(box.lo, box.hi, [&](std::uint32_t other, const detail::Box& near_box) {
-      loop_near_.push_back({other, near_box, {{}, kBallUnknown}});
-    });
+    gather_near(*cells, box, [](std::uint32_t) { return false; });
     return std::all_of(fan.begin(), fan.end(), [&](const Triangle& t) { return fill_fits(t); });
   }
 
@@ -715,13 +738,9 @@ class Grower {
     // border. Then nothing else is there for the border to continue into, and filling it closes
     // the object, where the filling neither crosses nor repeats a face (a flat quad's filling
     // would lie on it).
-    bool one_object = preloaded_ == 0 && !piece.empty();
-    std::uint32_t inside = 0;
-    for (std::uint32_t v = 0; v < piece.size() && one_object; ++v) {
-      one_object = piece[v] != kNoIndex && piece[v] == piece.front() && fillable(v);
-      inside += on_open[v] == 0;
-    }
-    one_object = one_object && inside <= 1;
+    std::uint32_t unused = 0;
+    const bool one_object = one_piece(piece, unused) && unused == 0 &&
+                            std::count(on_open.begin(), on_open.end(), std::uint8_t{0}) <= 1;
     std::vector<std::uint32_t> longest(grid_.size(), 0);
     if (!one_object) {
       for (const Loop& l : loops) longest[l.component] = std::max(longest[l.component], l.length);
@@ -768,13 +787,7 @@ class Grower {
       }
       if (!done) continue;
       for (const std::uint32_t m : attempt.merged) holes.taken[m] = 1;
-      // The triangles around face consistently along the loop: their groups become one, as
-      // they face now.
-      const std::uint32_t group = group_[attempt.outside.front()];
-      for (const std::uint32_t t : attempt.outside) {
-        groups_.unite(groups_.find(group).first, groups_.find(group_[t]).first, 0);
-      }
-      const std::uint8_t flip = groups_.find(group).second;
+      const auto [group, flip] = join_groups(attempt.outside);
       for (const std::uint32_t r : attempt.ring) {
         dead[r] = kUnlinked;
         const Triangle& tri = triangles_[r];
@@ -911,12 +924,7 @@ class Grower {
     // stay among them, so that a filling taken off again can give its ring back.
     detail::Box loop_box{grid_.point(loop_[0]), grid_.point(loop_[0])};
     for (const Index v : loop_) loop_box = detail::enclose(loop_box, grid_.point(v));
-    loop_near_.clear();
-    last_blocker_ = kNoIndex;
-    cells.for_each_near(loop_box.lo, loop_box.hi, [&](std::uint32_t other, const detail::Box& box) {
-      if (attempt.in_ring(other)) return;
-      loop_near_.push_back({other, box, {{}, kBallUnknown}});
-    });
+    gather_near(cells, loop_box, [&](std::uint32_t other) { return attempt.in_ring(other); });
     const auto triangle_ok = [&](std::size_t i, std::size_t k, std::size_t j) {
       return fill_fits({loop_[i], loop_[k], loop_[j]});
     };
