@@ -335,10 +335,11 @@ class Grower {
 
   // Removes the pieces of surface that have no interior point (a lone triangle, a strip: every
   // corner on an open edge, so not a surface patch of their own) and lie within
-  // kMaxLeftOutDistance spacings of another piece at every corner: on a noisy scan they are
-  // triangles grown in the layer beside the sheet, each a separate hole. Only pieces grown in
-  // this run at points it judges (fillable) go; their points are left out, as widened holes
-  // leave out points near the surface.
+  // kMaxLeftOutDistance spacings of a piece that stays for its own sake at every corner: on a
+  // noisy scan they are triangles grown in the layer beside the sheet, each a separate hole.
+  // Only pieces grown in this run at points it judges (fillable) go; their points are left out,
+  // as widened holes leave out points near the surface. Scraps near only other scraps are not
+  // near a surface (the corners of a cube give two opposite faces, each a scrap): they stay.
   void remove_scraps() {
     const auto n = static_cast<std::uint32_t>(grid_.size());
     const std::vector<std::uint32_t> piece = pieces();
@@ -351,11 +352,12 @@ class Grower {
     }
     for (std::size_t t = 0; t < preloaded_; ++t) keep[piece[triangles_[t][0]]] = 1;
     const double radius = kMaxLeftOutDistance * grid_.spacing();
+    const std::vector<std::uint8_t> patch = keep;  // the pieces that stay for their own sake
     for (std::uint32_t v = 0; v < n; ++v) {
-      if (piece[v] == kNoIndex || keep[piece[v]]) continue;
+      if (piece[v] == kNoIndex || patch[piece[v]]) continue;
       bool near = false;
       grid_.for_each_in_ball(grid_.position(v), radius, [&](std::uint32_t w, double) {
-        near = near || (piece[w] != kNoIndex && piece[w] != piece[v]);
+        near = near || (piece[w] != kNoIndex && patch[piece[w]]);
       });
       if (!near) keep[piece[v]] = 1;
     }

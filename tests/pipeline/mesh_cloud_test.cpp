@@ -381,6 +381,24 @@ TEST(Mesher, SquarePyramidIsClosedAndAFlatQuadStaysOpen) {
   EXPECT_EQ(stats_of(quad, open.triangles).boundary_edges, 4u);
 }
 
+TEST(Mesher, CornersOfACubeAndOfAPrismGiveAMeshNotNothing) {
+  // Their growth leaves pieces with no interior point (two opposite faces), each within a few
+  // spacings of the other. Such scraps go only when near a patch that stays: here nothing else
+  // is there, and removing them all left no triangle (the CLI then said the cloud was too
+  // sparse).
+  const PointCloud cube = from_points(
+      {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}});
+  const PointCloud prism =
+      from_points({{0, 0, 0}, {1, 0, 0}, {0.5, 0.866, 0}, {0, 0, 1}, {1, 0, 1}, {0.5, 0.866, 1}});
+  for (const auto& [cloud, name] : {std::pair{&cube, "cube"}, std::pair{&prism, "prism"}}) {
+    const PipelineMesh mesh = g2s::mesh_cloud(*cloud);
+    EXPECT_GE(mesh.triangles.size(), 2u) << name;
+    const MeshStats s = stats_of(*cloud, mesh.triangles);
+    expect_manifold(s, name);
+    EXPECT_EQ(s.crossing_pairs, 0u) << name;
+  }
+}
+
 TEST(Mesher, AllPointsIdenticalGiveNoTriangles) {
   PointCloud cloud;
   for (int i = 0; i < 1000; ++i) cloud.xyz.insert(cloud.xyz.end(), {4.5, -1.25, 3.0});
