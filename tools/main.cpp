@@ -17,11 +17,12 @@ int main(int argc, char** argv) {
       "folder, disk full); 5 no surface: the points cannot form one (none usable, all the same,\n"
       "two distinct, all on one line, too sparse), nothing written; 130 interrupted."};
   g2s::install_interrupt_cleanup();
-  // Tiles come and go in buffers of many sizes from several threads: served from mmap above a
-  // fixed size, they return to the system when freed, instead of glibc raising its threshold
-  // and keeping a fragmented heap that grows with the run (measured: +60% peak RSS at 40M
-  // points).
-  mallopt(M_MMAP_THRESHOLD, 1 << 20);
+  // A fixed threshold: glibc's own raises it as blocks are freed and keeps a fragmented heap
+  // that grows with the run (+60% peak RSS at 40M points). At 1 MiB every tile-sized array was
+  // a fresh mapping, and its page faults (expensive on virtual machines) took a quarter of the
+  // run; at 32 MiB a tile's arrays are reused from the heap: 20-33% less wall time, peak +6-30%,
+  // still well under --memory (bench/results/2026-11-27-heap-threshold.md).
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);
   app.require_subcommand(1);
   app.failure_message(g2s::cli::failure_message);
   app.set_version_flag("--version", "g2s 0.1.0");
