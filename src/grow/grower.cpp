@@ -354,7 +354,7 @@ class Grower {
     const double radius = kMaxLeftOutDistance * grid_.spacing();
     const std::vector<std::uint8_t> patch = keep;  // the pieces that stay for their own sake
     for (std::uint32_t v = 0; v < n; ++v) {
-      if (piece[v] == kNoIndex || patch[piece[v]]) continue;
+      if (piece[v] == kNoIndex || keep[piece[v]]) continue;  // a piece already known to stay
       bool near = false;
       grid_.for_each_in_ball(grid_.position(v), radius, [&](std::uint32_t w, double) {
         near = near || (piece[w] != kNoIndex && patch[piece[w]]);
