@@ -17,8 +17,8 @@ namespace g2s::io {
 
 // whole: every page is read in at once (fastest when the caller keeps the whole cloud anyway).
 // stream: pages are read in as touched, and release_before() drops the consumed ones.
-// random: as stream, for reads here and there (a tile store's blocks): no readahead beyond the
-// pages touched, so release() leaves nothing of them behind.
+// random: as stream, for reads here and there (the head and tail of an input, fingerprinted):
+// no readahead beyond the pages touched.
 enum class MapMode { whole, stream, random };
 
 class MappedFile {

@@ -16,8 +16,9 @@ namespace g2s::io {
 // the span is valid during the call only.
 using PointSink = std::function<void(std::span<const double> xyz)>;
 
-// Largest run a streaming PLY reader hands to a PointSink (24 MB of doubles).
-inline constexpr std::size_t kScanChunkPoints = std::size_t{1} << 20;
+// Largest run a streaming reader hands to a PointSink (1.5 MB of doubles: it stays in cache,
+// and a small memory budget is not spent on it).
+inline constexpr std::size_t kScanChunkPoints = std::size_t{1} << 16;
 
 // Streams the points of a cloud (any format read_points reads, same checks, same messages,
 // same numbering) to `sink` in bounded memory: the file is mapped lazily and consumed pages are

@@ -1,11 +1,17 @@
-// TileStore (docs/tile-store.md "Loading a tile and its halo"): maps the store, validates the
-// header and the tile table once, then loads a tile's frames on demand, checking each frame's
-// checksum as it is read. Nothing is modified after opening, so loads from several threads need no
-// locking.
+// TileStore (docs/tile-store.md "Loading a tile and its halo"): validates the header and the tile
+// table once, then loads a tile's frames on demand, checking each frame's checksum as it is read.
+// The store is read with pread into per-thread buffers, not mapped: a mapped store's pages stayed
+// resident after every load (the kernel maps whole page-cache folios around a fault, up to 2 MiB,
+// beyond any margin a release could guess), and held 44% of the store at small budgets. Nothing
+// is modified after opening, so loads from several threads need no locking.
+#include <fcntl.h>
 #include <fmt/core.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <zstd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -13,7 +19,6 @@
 
 #include "g2s/error.hpp"
 #include "g2s/tile_store.hpp"
-#include "io/mapped_file.hpp"
 #include "tiling/store_format.hpp"
 #include "tiling/xxhash64.hpp"
 
@@ -34,11 +39,75 @@ ZSTD_DCtx* thread_decompressor() {
   return holder.context;
 }
 
+// A tile store opened for reading at offsets. Opening problems (missing, directory, device,
+// permission) throw Error(bad_input) naming the file, as the point readers do.
+class StoreFile {
+ public:
+  explicit StoreFile(const std::filesystem::path& path) : name_(path.string()) {
+    fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd_ < 0) fail_errno("cannot open", errno);
+    struct stat st {};
+    if (::fstat(fd_, &st) != 0) fail_closing("cannot stat", errno);
+    if (S_ISDIR(st.st_mode)) fail_closing("is a directory, expected a file", 0);
+    if (!S_ISREG(st.st_mode)) fail_closing("not a regular file (a device, FIFO or socket)", 0);
+    size_ = static_cast<std::uint64_t>(st.st_size);
+  }
+  ~StoreFile() { ::close(fd_); }
+  StoreFile(const StoreFile&) = delete;
+  StoreFile& operator=(const StoreFile&) = delete;
+
+  const std::string& name() const { return name_; }
+  std::uint64_t size() const { return size_; }
+
+  // Reads [offset, offset + bytes) into `out` (resized to fit); the caller checked that the range
+  // lies in the file as opened, so a short read means the file shrank since.
+  void read(std::uint64_t offset, std::uint64_t bytes, std::vector<unsigned char>& out) const {
+    out.resize(bytes);
+    std::uint64_t done = 0;
+    while (done < bytes) {
+      const ssize_t n =
+          ::pread(fd_, out.data() + done, bytes - done, static_cast<off_t>(offset + done));
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) fail_errno("cannot read", errno);
+      if (n == 0) {
+        throw Error(Exit::bad_input,
+                    fmt::format("{}: truncated while it was read ({} bytes wanted at {})", name_,
+                                bytes, offset));
+      }
+      done += static_cast<std::uint64_t>(n);
+    }
+  }
+
+ private:
+  [[noreturn]] void fail_errno(const char* what, int err) const {
+    throw Error(Exit::bad_input, err ? fmt::format("{}: {}: {}", name_, what, std::strerror(err))
+                                     : fmt::format("{}: {}", name_, what));
+  }
+  [[noreturn]] void fail_closing(const char* what, int err) const {
+    ::close(fd_);  // no destructor runs after a constructor throws
+    fail_errno(what, err);
+  }
+
+  std::string name_;
+  int fd_ = -1;
+  std::uint64_t size_ = 0;
+};
+
+// Per-thread scratch for the stored bytes of a frame table and of a frame.
+std::vector<unsigned char>& thread_table_bytes() {
+  thread_local std::vector<unsigned char> bytes;
+  return bytes;
+}
+std::vector<unsigned char>& thread_frame_bytes() {
+  thread_local std::vector<unsigned char> bytes;
+  return bytes;
+}
+
 }  // namespace
 
 struct TileStore::Impl {
   std::filesystem::path path;
-  io::MappedFile file;
+  StoreFile file;
   bool compressed = false;
   std::uint64_t frame_points = 0;
   std::uint64_t point_count = 0;
@@ -50,16 +119,13 @@ struct TileStore::Impl {
   std::vector<std::uint64_t> block_bytes;
   std::vector<std::uint64_t> frame_table_checksum;
 
-  explicit Impl(const std::filesystem::path& store)
-      : path(store), file(store, io::MapMode::random) {}
+  explicit Impl(const std::filesystem::path& store) : path(store), file(store) {}
 
   template <typename... Args>
   [[noreturn]] void fail(fmt::format_string<Args...> format, Args&&... args) const {
     throw Error(Exit::bad_input,
                 file.name() + ": " + fmt::format(format, std::forward<Args>(args)...));
   }
-
-  const unsigned char* bytes(std::uint64_t offset) const { return file.bytes() + offset; }
 
   void open();
   void read_table(const unsigned char* table, std::uint64_t first_block, std::uint64_t end);
@@ -68,12 +134,14 @@ struct TileStore::Impl {
 };
 
 void TileStore::Impl::open() {
-  const std::size_t size = file.size();
+  const std::uint64_t size = file.size();
   if (size == 0) fail("file is empty (expected a g2s tile store)");
-  if (std::memcmp(file.bytes(), kMagic, std::min(size, sizeof kMagic)) != 0) {
+  std::vector<unsigned char> header_bytes_read;
+  file.read(0, std::min<std::uint64_t>(size, kHeaderBytes), header_bytes_read);
+  const unsigned char* h = header_bytes_read.data();
+  if (std::memcmp(h, kMagic, std::min<std::uint64_t>(size, sizeof kMagic)) != 0) {
     fail("not a g2s tile store (it does not start with the magic bytes 'G2STILES')");
   }
-  const unsigned char* h = file.bytes();
   if (size >= header::version + 4) {
     const auto version = load_le<std::uint32_t>(h + header::version);
     if (version != kVersion) {
@@ -126,15 +194,16 @@ void TileStore::Impl::open() {
     fail("header: tile table of {} tiles ({} bytes at {}) does not fit the {}-byte file",
          tile_count, table_bytes, table_offset, size);
   }
-  const unsigned char* table = bytes(table_offset);
-  if (xxhash64(table, table_bytes) != load_le<std::uint64_t>(h + header::table_checksum)) {
+  std::vector<unsigned char> table;
+  file.read(table_offset, table_bytes, table);
+  if (xxhash64(table.data(), table_bytes) != load_le<std::uint64_t>(h + header::table_checksum)) {
     fail("tile table checksum mismatch (the table is corrupt)");
   }
   tiles.resize(tile_count);
   block_offset.resize(tile_count);
   block_bytes.resize(tile_count);
   frame_table_checksum.resize(tile_count);
-  read_table(table, table_offset + table_bytes, file_bytes);
+  read_table(table.data(), table_offset + table_bytes, file_bytes);
 }
 
 // Reads the tile table and checks that it describes the file: blocks in tile order, back to
@@ -188,32 +257,34 @@ void TileStore::Impl::read_table(const unsigned char* table, std::uint64_t first
   }
 }
 
-// The frame table that opens a tile's block, checked against its checksum.
+// The frame table that opens a tile's block, read into this thread's buffer and checked
+// against its checksum.
 const unsigned char* TileStore::Impl::frame_table(std::size_t tile) const {
   if (tile >= tiles.size()) {
     throw Error(Exit::failure, fmt::format("{}: tile {} asked for; the store has {} tiles",
                                            file.name(), tile, tiles.size()));
   }
-  const unsigned char* table = bytes(block_offset[tile]);
+  std::vector<unsigned char>& table = thread_table_bytes();
   const std::uint64_t table_bytes =
       frame_count(tiles[tile].points, frame_points) * kFrameEntryBytes;
-  if (xxhash64(table, table_bytes) != frame_table_checksum[tile]) {
+  file.read(block_offset[tile], table_bytes, table);
+  if (xxhash64(table.data(), table_bytes) != frame_table_checksum[tile]) {
     fail("tile {}: frame table checksum mismatch (the block is corrupt)", tile);
   }
-  return table;
+  return table.data();
 }
 
-// The points of a tile's first `frames` frames, each checked against its checksum.
+// The points of a tile's first `frames` frames, each read and checked against its checksum.
 TilePoints TileStore::Impl::decode(std::size_t tile, const unsigned char* table,
                                    std::uint64_t frames) const {
   const TileInfo& info = tiles[tile];
-  const unsigned char* block = bytes(block_offset[tile]);
   const std::uint64_t all_frames = frame_count(info.points, frame_points);
   const std::uint64_t points = std::min(info.points, frames * frame_points);
   TilePoints out;
   out.xyz.resize(points * 3);
   out.ids.resize(points);
-  std::vector<unsigned char> unpacked;
+  std::vector<unsigned char>& stored = thread_frame_bytes();
+  thread_local std::vector<unsigned char> unpacked;
   std::uint64_t expected_offset = all_frames * kFrameEntryBytes;
   for (std::uint64_t f = 0; f < frames; ++f) {
     const unsigned char* e = table + f * kFrameEntryBytes;
@@ -224,18 +295,18 @@ TilePoints TileStore::Impl::decode(std::size_t tile, const unsigned char* table,
            stored_bytes, offset);
     }
     expected_offset += stored_bytes;
-    const unsigned char* stored = block + offset;
-    if (xxhash64(stored, stored_bytes) != load_le<std::uint64_t>(e + frame::checksum)) {
+    file.read(block_offset[tile] + offset, stored_bytes, stored);
+    if (xxhash64(stored.data(), stored_bytes) != load_le<std::uint64_t>(e + frame::checksum)) {
       fail("tile {} frame {}: checksum mismatch (the block is corrupt)", tile, f);
     }
     const std::uint64_t first = f * frame_points;
     const std::size_t m = std::min(frame_points, info.points - first);
     const std::size_t raw_bytes = m * kPointBytes;
-    const unsigned char* raw = stored;
+    const unsigned char* raw = stored.data();
     if (compressed) {
       unpacked.resize(raw_bytes);
       const std::size_t got = ZSTD_decompressDCtx(thread_decompressor(), unpacked.data(), raw_bytes,
-                                                  stored, stored_bytes);
+                                                  stored.data(), stored_bytes);
       if (ZSTD_isError(got) || got != raw_bytes) {
         fail("tile {} frame {}: does not decompress to {} points ({})", tile, f, m,
              ZSTD_isError(got) ? ZSTD_getErrorName(got) : "wrong size");
@@ -251,13 +322,6 @@ TilePoints TileStore::Impl::decode(std::size_t tile, const unsigned char* table,
     Index* id = out.ids.data() + first;
     for (std::size_t k = 0; k < m; ++k) id[k] = load_le<std::uint32_t>(ids + k * sizeof(Index));
   }
-  // The decoded copy is the caller's: the mapped pages need not stay resident (a pipeline
-  // loads every tile once; its memory should not grow to the size of the store). The whole
-  // block goes, and the kernel's fault-around window past it: a fault maps up to 64 KiB of
-  // neighbouring pages, which a border load would otherwise leave behind, tile after tile.
-  constexpr std::uint64_t kFaultAround = 64 * 1024;
-  file.release(block_offset[tile] > kFaultAround ? block_offset[tile] - kFaultAround : 0,
-               block_offset[tile] + block_bytes[tile] + kFaultAround);
   if (frames == all_frames && expected_offset != block_bytes[tile]) {
     fail("tile {}: the frames end at byte {} of a {}-byte block (corrupt block)", tile,
          expected_offset, block_bytes[tile]);

@@ -45,9 +45,10 @@ constexpr std::size_t kSampleTarget = std::size_t{1} << 18;
 // A tile split on a partial sample aims this far below the budget, so that the counting pass
 // rarely finds one over it.
 constexpr double kSampledTargetFraction = 0.75;
-// The spill pass's per-tile buffers share this much (one point a tile at least, which is less
-// than the tile's table entry): 124 KB a tile for the 258 tiles of 160M points under --memory
-// 1G, so each write moves over 100 KB at once, and freed before the rounds allocate theirs.
+// The spill pass's per-tile buffers share this much, or the round's points' worth if less (the
+// writer's memory bound; one point a tile at least, which is less than the tile's table entry):
+// 124 KB a tile for the 258 tiles of 160M points under --memory 1G, so each write moves over
+// 100 KB at once, and freed before the rounds allocate theirs.
 constexpr std::size_t kSpillBufferBytes = std::size_t{32} << 20;
 
 // Streams the finite points of the input with their global ids; returns the reader's report.
@@ -197,11 +198,12 @@ class SpillFile {
 // total.
 void spill_points(const std::filesystem::path& input, const TileTree& tree,
                   std::span<const std::uint32_t> tile_of_node,
-                  std::span<const std::uint64_t> tile_start, const ReadReport& report,
-                  SpillFile& spill) {
+                  std::span<const std::uint64_t> tile_start, std::uint64_t round_points,
+                  const ReadReport& report, SpillFile& spill) {
   const std::size_t tiles = tile_start.size() - 1;
   const std::uint64_t ids_offset = 3 * sizeof(double) * tile_start[tiles];
-  const std::size_t per_tile = std::max<std::size_t>(kSpillBufferBytes / (kPointBytes * tiles), 1);
+  const std::size_t shared = std::min<std::uint64_t>(kSpillBufferBytes, kPointBytes * round_points);
+  const std::size_t per_tile = std::max<std::size_t>(shared / (kPointBytes * tiles), 1);
   std::vector<double> xyz(3 * per_tile * tiles);
   std::vector<Index> ids(per_tile * tiles);
   std::vector<std::uint64_t> flushed(tile_start.begin(), tile_start.end() - 1);  // in tile order
@@ -436,7 +438,7 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
   std::unique_ptr<SpillFile> spill;
   if (round_first.size() > 2) {
     spill = std::make_unique<SpillFile>(file, kPointBytes * total);
-    spill_points(input, tree, tile_of_node, tile_start, first, *spill);
+    spill_points(input, tree, tile_of_node, tile_start, round_points, first, *spill);
   }
 
   BlockScratch scratch;

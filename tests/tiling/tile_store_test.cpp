@@ -161,7 +161,8 @@ TEST_F(TileStoreTest, ScanPointsStreamsWhatReadPointsReads) {
                              "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\n"
                              "property float y\nproperty float z\nend_header\n" +
                                  body);
-  const fs::path big = synthetic("big.ply", g2s::SynthShape::torus, 1'300'000);  // 2 runs
+  const fs::path big = synthetic("big.ply", g2s::SynthShape::torus,
+                                 g2s::io::kScanChunkPoints * 3 / 2);  // 2 runs
   for (const fs::path& path : {write("a.xyz", body), ply, big}) {
     g2s::ReadReport expected_report;
     const g2s::PointCloud expected = g2s::read_points(path, &expected_report);
