@@ -230,9 +230,11 @@ void add_mesh_command(CLI::App& app) {
   add_output_options(*cmd, args->out);
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")
       ->check(count_range(0, kMostThreads));
-  cmd->add_option("--memory", args->memory,
-                  "Memory budget, e.g. 512M or 4G (default: half the machine's RAM): sets the "
-                  "tile size and the tiles in flight; the peak resident memory stays below it")
+  cmd->add_option(
+         "--memory", args->memory,
+         "Memory budget, e.g. 512M or 4G (default: half the machine's RAM): sets the "
+         "tile size and the tiles in flight; the peak resident memory stays below it (below "
+         "about 100M, only for clouds of a few million points)")
       ->transform(byte_size());
   cmd->add_option("--tile-points", args->tile_points,
                   "Largest number of points in a tile (default: a quarter of the cloud, at "
