@@ -51,6 +51,13 @@ struct MeshStats {
   double off_mesh_p90 = 0.0;
   double off_mesh_p99 = 0.0;
   double off_mesh_max = 0.0;
+  // Of the points off the mesh, those with fewer than two other input points (at other
+  // positions) within 2 spacings: no triangle with sides of at most 2 spacings can have them as
+  // a corner, so they are outliers, not surface left out. surface_coverage is covered_points
+  // over input_points less those (equal to coverage when none is left out).
+  std::uint64_t off_mesh_isolated = 0;
+  std::uint64_t off_mesh_far_not_isolated = 0;  // not isolated, yet more than 2 spacings off
+  double surface_coverage = 0.0;
 };
 
 // Measures a mesh, in this order:

@@ -63,6 +63,26 @@ class BoxTree {
     return best;
   }
 
+  // Calls visit(item) for the items whose boxes lie within `radius` of p (a superset of the
+  // items within radius: the caller measures them).
+  template <typename Visit>
+  void for_each_near(const double p[3], double radius, Visit&& visit) const {
+    if (nodes_.empty()) return;
+    std::uint32_t stack[128];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+      const Node& node = nodes_[stack[--top]];
+      if (box_distance(node, p) > radius) continue;
+      if (node.count > 0) {
+        for (std::uint32_t i = node.first; i < node.first + node.count; ++i) visit(order_[i]);
+        continue;
+      }
+      stack[top++] = static_cast<std::uint32_t>(&node - nodes_.data()) + 1;
+      stack[top++] = node.first;
+    }
+  }
+
  private:
   static constexpr std::uint32_t kLeafSize = 4;
   struct Node {

@@ -20,6 +20,10 @@ namespace g2s::stats {
 namespace {
 
 constexpr std::size_t kSpacingSample = 65536;
+// A point left out with fewer than two other points within this many spacings is isolated: no
+// triangle whose sides are that short can have it as a corner (the same two spacings within
+// which a left-out surface point should lie of the mesh).
+constexpr double kIsolationSpacings = 2.0;
 
 bool finite(const double* p) {
   return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
@@ -29,17 +33,41 @@ Vec3 at(const double* p) {
   return {p[0], p[1], p[2]};
 }
 
-// Median distance from every k-th point to its nearest point at another position.
-double median_spacing(const PointCloud& cloud) {
-  std::vector<std::uint32_t> points;
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    if (finite(&cloud.xyz[3 * i])) points.push_back(static_cast<std::uint32_t>(i));
+// The cloud's finite points in a box tree.
+struct PointTree {
+  explicit PointTree(const PointCloud& cloud)
+      : points(finite_points(cloud)), tree(points.size(), [&](std::size_t i) {
+          const double* p = &cloud.xyz[3 * std::size_t{points[i]}];
+          return BoxTree::Box{{p[0], p[1], p[2]}, {p[0], p[1], p[2]}};
+        }) {}
+  static std::vector<std::uint32_t> finite_points(const PointCloud& cloud) {
+    std::vector<std::uint32_t> out;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      if (finite(&cloud.xyz[3 * i])) out.push_back(static_cast<std::uint32_t>(i));
+    }
+    return out;
   }
-  if (points.size() < 2) return 0.0;
-  const BoxTree tree(points.size(), [&](std::size_t i) {
-    const double* p = &cloud.xyz[3 * std::size_t{points[i]}];
-    return BoxTree::Box{{p[0], p[1], p[2]}, {p[0], p[1], p[2]}};
+  std::vector<std::uint32_t> points;  // indices into the cloud
+  BoxTree tree;
+};
+
+// Whether fewer than two other points (at other positions) lie within `radius` of point q: then
+// no triangle with sides of at most `radius` can have it as a corner.
+bool isolated(const PointCloud& cloud, const PointTree& near, const double* q, double radius) {
+  const Vec3 p = at(q);
+  int others = 0;
+  near.tree.for_each_near(q, radius, [&](std::uint32_t i) {
+    const double d = norm(at(&cloud.xyz[3 * std::size_t{near.points[i]}]) - p);
+    others += d > 0.0 && d <= radius;
   });
+  return others < 2;
+}
+
+// Median distance from every k-th point to its nearest point at another position.
+double median_spacing(const PointCloud& cloud, const PointTree& near) {
+  const std::vector<std::uint32_t>& points = near.points;
+  const BoxTree& tree = near.tree;
+  if (points.size() < 2) return 0.0;
   const std::size_t step = (points.size() + kSpacingSample - 1) / kSpacingSample;
   std::vector<double> nearest((points.size() + step - 1) / step);
   tbb::parallel_for(std::size_t{0}, nearest.size(), [&](std::size_t s) {
@@ -74,9 +102,11 @@ void measure_point_distances(std::span<const Triangle> triangles, const double* 
       usable.push_back(static_cast<std::uint32_t>(t));
     }
   }
-  stats.spacing = median_spacing(cloud);
+  const PointTree near(cloud);
+  stats.spacing = median_spacing(cloud, near);
   if (usable.empty() || !(stats.spacing > 0.0)) return;
   stats.has_distances = true;
+  stats.surface_coverage = stats.coverage;
   if (off_mesh.empty()) return;  // every point is a vertex: nothing to measure
 
   const BoxTree tree(usable.size(), [&](std::size_t i) {
@@ -89,6 +119,7 @@ void measure_point_distances(std::span<const Triangle> triangles, const double* 
     return box;
   });
   std::vector<double> distance(off_mesh.size());
+  std::vector<std::uint8_t> alone(off_mesh.size(), 0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, off_mesh.size(), 256), [&](const auto& r) {
     for (std::size_t i = r.begin(); i < r.end(); ++i) {
       const double* q = &cloud.xyz[3 * off_mesh[i]];
@@ -96,6 +127,7 @@ void measure_point_distances(std::span<const Triangle> triangles, const double* 
         distance[i] = std::numeric_limits<double>::quiet_NaN();
         continue;
       }
+      alone[i] = isolated(cloud, near, q, kIsolationSpacings * stats.spacing);
       const Vec3 p = at(q);
       distance[i] = tree.nearest(q, [&](std::uint32_t item) {
         const Triangle& tri = triangles[usable[item]];
@@ -104,6 +136,14 @@ void measure_point_distances(std::span<const Triangle> triangles, const double* 
       }) / stats.spacing;
     }
   });
+  stats.off_mesh_isolated = static_cast<std::uint64_t>(std::count(alone.begin(), alone.end(), 1));
+  for (std::size_t i = 0; i < distance.size(); ++i) {
+    stats.off_mesh_far_not_isolated += !alone[i] && distance[i] > kIsolationSpacings;
+  }
+  const std::uint64_t surface_points = stats.input_points - stats.off_mesh_isolated;
+  stats.surface_coverage = surface_points > 0 ? static_cast<double>(stats.covered_points) /
+                                                    static_cast<double>(surface_points)
+                                              : 0.0;
   distance.erase(
       std::remove_if(distance.begin(), distance.end(), [](double d) { return std::isnan(d); }),
       distance.end());

@@ -50,6 +50,9 @@ std::vector<Field> fields(const MeshStats& s) {
     out.push_back({"off_mesh_within_2_spacings", "  within 2 spacings", s.off_mesh_within_2});
     out.push_back({"off_mesh_within_4_spacings", "  within 4 spacings", s.off_mesh_within_4});
     out.push_back({"off_mesh_beyond_4_spacings", "  beyond 4 spacings", s.off_mesh_beyond_4});
+    out.push_back({"off_mesh_isolated", "  isolated (outliers)", s.off_mesh_isolated});
+    out.push_back(
+        {"off_mesh_far_not_isolated", "  beyond 2, not isolated", s.off_mesh_far_not_isolated});
   }
   return out;
 }
@@ -84,6 +87,9 @@ std::string stats_to_json(const MeshStats& stats) {
   }
   // {} prints the shortest decimal that reads back as the same double: valid JSON, no NaN.
   if (stats.has_coverage) out += fmt::format(",\n  \"coverage\": {}", stats.coverage);
+  if (stats.has_distances) {
+    out += fmt::format(",\n  \"surface_coverage\": {}", stats.surface_coverage);
+  }
   for (const Measure& m : measures(stats)) out += fmt::format(",\n  \"{}\": {}", m.key, m.value);
   out += "\n}";
   return out;
@@ -94,6 +100,10 @@ std::string stats_to_text(const MeshStats& stats) {
   for (const Field& f : fields(stats)) out += fmt::format("{:<26}{:>14}\n", f.label, f.value);
   if (stats.has_coverage) {
     out += fmt::format("{:<26}{:>13.3f}%\n", "coverage", 100.0 * stats.coverage);
+  }
+  if (stats.has_distances) {
+    out += fmt::format("{:<26}{:>13.3f}%\n", "  isolated points aside",
+                       100.0 * stats.surface_coverage);
   }
   for (const Measure& m : measures(stats))
     out += fmt::format("{:<26}{:>14.4g}\n", m.label, m.value);

@@ -29,6 +29,10 @@ struct Baseline {
   double min_coverage;
   std::uint64_t max_boundary_edges;
   std::uint64_t max_holes;
+  // Issue 16's floor on the coverage of the points that can lie on a surface (isolated points,
+  // with fewer than two others within two spacings, aside): 99.5% on clean single-layer scans,
+  // 97% on the noisy and layered ones.
+  double min_surface_coverage;
 };
 
 // So that test listings name the cloud rather than dump the struct's bytes.
@@ -67,6 +71,16 @@ TEST_P(RealScan, MeshIsManifoldOrientedAndMeetsItsBaseline) {
     EXPECT_LE(per_point, 2.02);
   }
   EXPECT_GE(s.coverage, b.min_coverage);
+  ASSERT_TRUE(s.has_distances);
+  std::printf(
+      "%s: surface coverage %.4f (%llu isolated points aside), %llu points left out "
+      "farther than 2 spacings that are not isolated\n",
+      b.name, s.surface_coverage, static_cast<unsigned long long>(s.off_mesh_isolated),
+      static_cast<unsigned long long>(s.off_mesh_far_not_isolated));
+  EXPECT_GE(s.surface_coverage, b.min_surface_coverage);
+  // A point left out lies within two spacings of the mesh unless it is isolated: all but a few
+  // in ten thousand (measured: 0 to 65 on these scans).
+  EXPECT_LE(s.off_mesh_far_not_isolated, cloud.size() / 1000);
   EXPECT_LE(s.boundary_edges, b.max_boundary_edges);
   EXPECT_LE(s.holes, b.max_holes);
 }
@@ -146,14 +160,15 @@ TEST(RealScanGaps, WideningHolesLeavesFewerHolesAndOnlyPointsNearTheSurfaceOut) 
 // leave out points near the surface: the noisy scans' coverage fell by 0.1 to 0.8 points.
 INSTANTIATE_TEST_SUITE_P(
     SharedData, RealScan,
-    ::testing::Values(Baseline{"closed-kitten", true, 0.995, 0, 0},
-                      Baseline{"closed-bunny-zipper", true, 0.995, 8, 1},
-                      Baseline{"open-bunny-scan-bun000", false, 0.9977, 690, 7},
-                      Baseline{"raw-bunny", false, 0.9813, 18192, 819},
-                      Baseline{"open-table-mug-stereo", false, 0.9923, 5205, 79},
-                      Baseline{"open-lion-photogrammetry", false, 0.9921, 16624, 490},
-                      Baseline{"open-autzen-lidar", false, 0.9886, 10090, 264},
-                      Baseline{"open-alpe-selle-photogrammetry", false, 0.9784, 2464642, 30206}),
+    ::testing::Values(Baseline{"closed-kitten", true, 0.995, 0, 0, 0.995},
+                      Baseline{"closed-bunny-zipper", true, 0.995, 8, 1, 0.995},
+                      Baseline{"open-bunny-scan-bun000", false, 0.9977, 690, 7, 0.995},
+                      Baseline{"raw-bunny", false, 0.9813, 18192, 819, 0.97},
+                      Baseline{"open-table-mug-stereo", false, 0.9923, 5205, 79, 0.97},
+                      Baseline{"open-lion-photogrammetry", false, 0.9921, 16624, 490, 0.97},
+                      Baseline{"open-autzen-lidar", false, 0.9886, 10090, 264, 0.995},
+                      Baseline{"open-alpe-selle-photogrammetry", false, 0.9784, 2464642, 30206,
+                               0.97}),
     [](const ::testing::TestParamInfo<Baseline>& param) {
       std::string name = param.param.name;
       for (char& c : name) {

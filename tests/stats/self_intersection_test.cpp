@@ -564,9 +564,15 @@ TEST(StatsPointDistances, KnownDistancesInSpacings) {
   EXPECT_DOUBLE_EQ(s.off_mesh_median, 0.0);
   EXPECT_DOUBLE_EQ(s.off_mesh_max, 10.0);
   EXPECT_DOUBLE_EQ(s.off_mesh_p99, 5.0);  // the 25th of 26 sorted distances
+  // Isolated: 3 above (one point within 2, at 1.5), 5 beside and 10 below (none within 2). The
+  // points at 0.5 and 1.5 above have more neighbours, and lie within 2 of the mesh.
+  EXPECT_EQ(s.off_mesh_isolated, 3u);
+  EXPECT_EQ(s.off_mesh_far_not_isolated, 0u);
+  EXPECT_DOUBLE_EQ(s.surface_coverage, 4.0 / 27.0);
 
   const std::string json = g2s::stats_to_json(s);
   EXPECT_NE(json.find("\"off_mesh_beyond_4_spacings\": 2,"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"off_mesh_isolated\": 3,"), std::string::npos) << json;
   EXPECT_NE(json.find("\"off_mesh_distance_max\": 10\n}"), std::string::npos) << json;
   EXPECT_FALSE(g2s::compute_stats(mesh).has_distances);
 }

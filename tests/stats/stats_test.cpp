@@ -487,7 +487,10 @@ TEST(Stats, JsonHasEveryKeyInOrder) {
                         "off_mesh_within_2_spacings",
                         "off_mesh_within_4_spacings",
                         "off_mesh_beyond_4_spacings",
+                        "off_mesh_isolated",
+                        "off_mesh_far_not_isolated",
                         "coverage",
+                        "surface_coverage",
                         "spacing",
                         "off_mesh_distance_median",
                         "off_mesh_distance_p90",
@@ -528,7 +531,7 @@ TEST(Stats, TextIsAligned) {
     start = end + 1;
     ++lines;
   }
-  EXPECT_EQ(lines, 28);
+  EXPECT_EQ(lines, 31);
 }
 
 // The command line: `g2s stats` on an ASCII STL written here (STL is a triangle soup, so this
