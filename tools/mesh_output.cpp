@@ -95,12 +95,24 @@ std::string why_tile_too_wide(const TileSource& source) {
 namespace {
 
 // Why the points of `source` cannot form a surface (none, one point, two, a line), or "". A
-// tile too wide for float precision is named first: it is the true reason then.
-std::string why_no_surface(const TileSource& source) {
-  const std::string why =
-      g2s::why_no_surface(source.point_count(), [&source](const PointRun& visit) {
-        for (std::size_t t = 0; t < source.tiles().size(); ++t) visit(source.load(t).xyz);
-      });
+// tile too wide for float precision is named first: it is the true reason then. Sets
+// `all_float` to whether every coordinate is exactly a float, read on the check's first pass
+// over the points (a pass the check makes anyway).
+std::string why_no_surface(const TileSource& source, bool& all_float) {
+  all_float = true;
+  bool first_pass = true;
+  const std::string why = g2s::why_no_surface(source.point_count(), [&](const PointRun& visit) {
+    for (std::size_t t = 0; t < source.tiles().size(); ++t) {
+      const TilePoints points = source.load(t);
+      if (first_pass) {
+        for (const double c : points.xyz) {
+          all_float = all_float && static_cast<double>(static_cast<float>(c)) == c;
+        }
+      }
+      visit(points.xyz);
+    }
+    first_pass = false;
+  });
   if (why.empty()) return {};
   const std::string too_wide = why_tile_too_wide(source);
   return too_wide.empty() ? why : too_wide;
@@ -187,12 +199,18 @@ void write_and_report(const TileSource& source,
                       const RunFacts& facts) {
   const MeshFormat format = checked_mesh_format(args.output, args.ascii);
   // A degenerate cloud is refused before meshing: the mesher would make slivers of it.
-  if (const std::string why = why_no_surface(source); !why.empty()) throw_no_surface(why, facts);
+  bool all_float = false;
+  if (const std::string why = why_no_surface(source, all_float); !why.empty()) {
+    throw_no_surface(why, facts);
+  }
   install_output_signal_handler(args.output, facts.temporary_store);
   MeshStreamWriter writer(args.output, format);
   TimedFinish timed(writer);
-  // STL stores float coordinates: the count welds and judges them as read back.
-  StreamStats counter(timed, format != MeshFormat::ply_binary);
+  // STL stores float coordinates: the count welds and judges them as read back. The vertices are
+  // distinct input points (exact duplicates are merged), so they can share a stored position
+  // only where STL rounds distinct doubles to one float.
+  const bool rounded = format != MeshFormat::ply_binary;
+  StreamStats counter(timed, rounded, !rounded || all_float);
   const auto mesh_start = std::chrono::steady_clock::now();
   const double mesh_cpu = cpu_seconds();
   const PipelineSummary summary = args.no_stats ? run(timed) : run(static_cast<MeshSink&>(counter));

@@ -15,7 +15,11 @@ namespace g2s {
 // A MeshSink that passes everything on to `next` and counts the mesh's defects on the way.
 // Positions are taken as the file will hold them: rounded to float when `float_positions` (STL),
 // exact otherwise (PLY keeps every coordinate). The vertices are welded by those positions and
-// degenerate and duplicate triangles set aside exactly as compute_stats does; a vertex's edges
+// degenerate and duplicate triangles set aside exactly as compute_stats does. When
+// `positions_distinct`, the caller promises that no two vertices share a position as stored, and
+// the welding (a hash probe per vertex, the count's largest cost) is skipped: the pipeline's
+// vertices are distinct input points, so this holds for PLY, and for STL when every input
+// coordinate is exactly a float. A vertex's edges
 // and fans are counted when the sink is told it is done (vertex_done), the orientation
 // conflicts between groups once finish() gives the groups' flips.
 //
@@ -26,7 +30,7 @@ namespace g2s {
 // stars, its tables), in bytes.
 class StreamStats final : public MeshSink {
  public:
-  StreamStats(MeshSink& next, bool float_positions);
+  StreamStats(MeshSink& next, bool float_positions, bool positions_distinct);
   ~StreamStats() override;
   StreamStats(const StreamStats&) = delete;
   StreamStats& operator=(const StreamStats&) = delete;

@@ -227,10 +227,12 @@ struct StreamStats::Impl {
     std::uint32_t overflow;  // the list holding wedges past the inline ones (kNoIndex: none)
     Wedge inline_wedges[kInlineWedges];
   };
-  Impl(MeshSink& sink, bool rounded) : next(sink), float_positions(rounded) {}
+  Impl(MeshSink& sink, bool rounded, bool distinct)
+      : next(sink), float_positions(rounded), welding(!distinct) {}
 
   MeshSink& next;
   bool float_positions;
+  bool welding;  // vertices may share a position: weld them by it
   MeshStats stats = crossings_not_counted();
   bool complete = true;
   std::uint32_t numbered = 0;  // vertices given so far
@@ -345,8 +347,8 @@ struct StreamStats::Impl {
     const std::uint32_t number = numbered++;
     double p[3];
     stored_position(given, p);
-    const std::uint32_t key = weld_key(p);
-    std::uint32_t o = welder_find(p, key);
+    const std::uint32_t key = welding ? weld_key(p) : 0;
+    std::uint32_t o = welding ? welder_find(p, key) : kNoIndex;
     if (o == kNoIndex) {
       if (free_open.empty()) {
         o = slots++;
@@ -368,7 +370,7 @@ struct StreamStats::Impl {
       node[o].component = components.add();
       node[o].border = borders.add();
       ++open_count;
-      welder_insert(o, key);
+      if (welding) welder_insert(o, key);
     }
     ++node[o].refs;
     if (components.parent.size() > 2 * open_count + 4096) compact();
@@ -497,7 +499,7 @@ struct StreamStats::Impl {
     if (!wedges.empty()) ++stats.vertices;
     if (!judge_simple_star(o, wedges)) judge_star(o, wedges);
     open_of.erase(vertex.rep);
-    welder_erase(o);
+    if (welding) welder_erase(o);
     node[o].refs = 0;
     free_open.push_back(o);
     --open_count;
@@ -669,8 +671,8 @@ struct StreamStats::Impl {
   }
 };
 
-StreamStats::StreamStats(MeshSink& next, bool float_positions)
-    : impl_(std::make_unique<Impl>(next, float_positions)) {}
+StreamStats::StreamStats(MeshSink& next, bool float_positions, bool positions_distinct)
+    : impl_(std::make_unique<Impl>(next, float_positions, positions_distinct)) {}
 StreamStats::~StreamStats() = default;
 
 // The next sink first: it reads the position anyway (the writer stores it), so the counter finds

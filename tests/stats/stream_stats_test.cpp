@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -17,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "g2s/io.hpp"
 #include "g2s/stats.hpp"
 #include "support/cli.hpp"
 #include "support/temp_folder.hpp"
@@ -41,9 +43,9 @@ class NullSink final : public g2s::MeshSink {
 // left to finish()), and the groups in `flip` reversed at the end.
 MeshStats streamed(const IndexedMesh& mesh, const std::vector<std::uint32_t>& group,
                    const std::vector<std::uint8_t>& flip, bool early, bool* complete,
-                   bool float_positions = false) {
+                   bool float_positions = false, bool positions_distinct = false) {
   NullSink null;
-  g2s::StreamStats counter(null, float_positions);
+  g2s::StreamStats counter(null, float_positions, positions_distinct);
   // A vertex is done after the last triangle at its position (as stored): the pipeline gives
   // every vertex welded to another its number while that one is still open.
   std::map<std::array<double, 3>, std::size_t> last_at;
@@ -96,6 +98,20 @@ IndexedMesh as_written(IndexedMesh mesh, const std::vector<std::uint32_t>& group
     if (flip[group[t]]) std::swap(mesh.triangles[t][1], mesh.triangles[t][2]);
   }
   return mesh;
+}
+
+// The vertices of a rows x columns grid on a torus (radii 3 and 1), row by row, each coordinate
+// as `store` gives it.
+template <class Store>
+void add_torus_grid(IndexedMesh& mesh, std::uint32_t rows, std::uint32_t columns, Store store) {
+  for (std::uint32_t r = 0; r < rows; ++r) {
+    for (std::uint32_t c = 0; c < columns; ++c) {
+      const double u = 2 * M_PI * c / columns, v = 2 * M_PI * r / rows;
+      const double p[3] = {(3 + std::cos(v)) * std::cos(u), (3 + std::cos(v)) * std::sin(u),
+                           std::sin(v)};
+      for (double x : p) mesh.xyz.push_back(store(x));
+    }
+  }
 }
 
 // a: counted in stride, which leaves crossings to g2s stats (and says so); b: compute_stats.
@@ -171,14 +187,7 @@ TEST(StreamStats, RandomSoupsWithWeldedPositions) {
 TEST(StreamStats, LargeSurfaceWithDefectsAsComputeStatsCountsIt) {
   const std::uint32_t rows = 400, columns = 360;
   IndexedMesh mesh;
-  for (std::uint32_t r = 0; r < rows; ++r) {
-    for (std::uint32_t c = 0; c < columns; ++c) {
-      const double u = 2 * M_PI * c / columns, v = 2 * M_PI * r / rows;
-      const double p[3] = {(3 + std::cos(v)) * std::cos(u), (3 + std::cos(v)) * std::sin(u),
-                           std::sin(v)};
-      for (double x : p) mesh.xyz.push_back(std::round(x * 1e3) / 1e3);
-    }
-  }
+  add_torus_grid(mesh, rows, columns, [](double x) { return std::round(x * 1e3) / 1e3; });
   auto at = [&](std::uint32_t r, std::uint32_t c) { return (r % rows) * columns + c % columns; };
   std::vector<std::uint32_t> group;
   std::mt19937 random(11);
@@ -230,6 +239,54 @@ TEST(StreamStats, LargeSurfaceWithDefectsAsComputeStatsCountsIt) {
   }
 }
 
+// Without welding (positions_distinct: no two vertices share a position, as for the pipeline's
+// distinct input points), the counts are the same, on a torus of float coordinates with holes,
+// reversed triangles, duplicates and fins.
+TEST(StreamStats, DistinctPositionsNeedNoWelding) {
+  const std::uint32_t rows = 120, columns = 90;
+  IndexedMesh mesh;
+  add_torus_grid(mesh, rows, columns,
+                 [](double x) { return static_cast<double>(static_cast<float>(x)); });
+  auto at = [&](std::uint32_t r, std::uint32_t c) { return (r % rows) * columns + c % columns; };
+  std::vector<std::uint32_t> group;
+  std::mt19937 random(5);
+  for (std::uint32_t r = 0; r < rows; ++r) {
+    for (std::uint32_t c = 0; c < columns; ++c) {
+      const Triangle a{at(r, c), at(r, c + 1), at(r + 1, c + 1)};
+      const Triangle b{at(r, c), at(r + 1, c + 1), at(r + 1, c)};
+      for (Triangle t : {a, b}) {
+        const auto draw = static_cast<std::uint32_t>(random() % 100);
+        if (draw < 2) continue;               // a hole
+        if (draw < 4) std::swap(t[1], t[2]);  // reversed
+        mesh.triangles.push_back(t);
+        group.push_back(r / 30);
+        if (draw == 4) {  // a duplicate, then a fin on its first edge
+          mesh.triangles.push_back({t[1], t[2], t[0]});
+          mesh.triangles.push_back({t[0], t[1], at(r + 3, c + 7)});
+          group.push_back(r / 30);
+          group.push_back(r / 30 + 1);
+        }
+      }
+    }
+  }
+  std::vector<std::uint8_t> flip(rows / 30 + 2);
+  for (std::size_t g = 0; g < flip.size(); ++g) flip[g] = g % 2;
+  const MeshStats expected = g2s::compute_stats(as_written(mesh, group, flip));
+  ASSERT_GT(expected.holes, 0u);
+  ASSERT_GT(expected.orientation_conflicts, 0u);
+  ASSERT_GT(expected.non_manifold_edges, 0u);
+  ASSERT_GT(expected.duplicate_triangles, 0u);
+  for (bool float_positions : {false, true}) {
+    for (bool early : {false, true}) {
+      bool complete = false;
+      expect_same(streamed(mesh, group, flip, early, &complete, float_positions, true), expected,
+                  std::string(float_positions ? "float" : "double") +
+                      (early ? ", done early" : ", done at the end"));
+      EXPECT_TRUE(complete);
+    }
+  }
+}
+
 // `g2s mesh`'s own summary against `g2s stats` on the written file.
 class MeshSummary : public ::testing::Test {
  protected:
@@ -253,12 +310,26 @@ class MeshSummary : public ::testing::Test {
   const fs::path dir_ = folder_.path();
 };
 
+// The PLY scans' coordinates are floats, so the count skips welding (for STL too); bun000
+// shifted by 1e-10 and written as text is not, so STL's count welds.
 TEST_F(MeshSummary, CountedInStrideAsGStatsCountsTheFile) {
-  for (const char* scan : {"open-bunny-scan-bun000", "open-autzen-lidar", "raw-bunny"}) {
-    G2S_SKIP_WITHOUT_DATA(g2s::test_support::data_dir() / (std::string(scan) + ".ply"));
+  const char* scans[] = {"open-bunny-scan-bun000.ply", "open-autzen-lidar.ply", "raw-bunny.ply"};
+  for (const char* scan : scans) G2S_SKIP_WITHOUT_DATA(g2s::test_support::data_dir() / scan);
+  const g2s::PointCloud bun000 = g2s::read_points(g2s::test_support::data_dir() / scans[0]);
+  const fs::path shifted = dir_ / "bun000-shifted.xyz";
+  {
+    std::FILE* out = std::fopen(shifted.c_str(), "w");
+    ASSERT_NE(out, nullptr);
+    for (std::size_t i = 0; i < bun000.size(); ++i) {
+      const double* p = &bun000.xyz[3 * i];
+      std::fprintf(out, "%.17g %.17g %.17g\n", p[0] + 1e-10, p[1] + 1e-10, p[2] + 1e-10);
+    }
+    std::fclose(out);
   }
-  for (const char* scan : {"open-bunny-scan-bun000", "open-autzen-lidar", "raw-bunny"}) {
-    const fs::path cloud = g2s::test_support::data_dir() / (std::string(scan) + ".ply");
+  for (const fs::path& cloud :
+       {g2s::test_support::data_dir() / scans[0], g2s::test_support::data_dir() / scans[1],
+        g2s::test_support::data_dir() / scans[2], shifted}) {
+    const std::string scan = cloud.filename().string();
     for (const char* extension : {".stl", ".ply"}) {
       const fs::path mesh = dir_ / (std::string("mesh") + extension);
       const std::string summary =
