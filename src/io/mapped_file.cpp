@@ -24,34 +24,53 @@ namespace {
   throw Error(Exit::bad_input, fmt::format("{}: {}: {}", name, what, std::strerror(err)));
 }
 
-struct FdGuard {
-  int fd;
-  ~FdGuard() {
-    if (fd >= 0) ::close(fd);
-  }
-};
-
 }  // namespace
 
-MappedFile::MappedFile(const std::filesystem::path& path, MapMode mode)
-    : name_(path.string()), mode_(mode) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) fail_errno(name_, "cannot open", errno);
-  FdGuard guard{fd};
+InputFile::InputFile(const std::filesystem::path& path) : name_(path.string()) {
+  fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd_ < 0) fail_errno(name_, "cannot open", errno);
   struct stat st {};
-  if (::fstat(fd, &st) != 0) fail_errno(name_, "cannot stat", errno);
-  if (S_ISDIR(st.st_mode)) {
-    throw Error(Exit::bad_input, fmt::format("{}: is a directory, expected a file", name_));
-  }
-  // A device or FIFO may never end (/dev/zero, a pipe from `yes`): reading it whole would fill
-  // the memory, so only regular files are read.
-  if (!S_ISREG(st.st_mode)) {
+  const int stat_error = ::fstat(fd_, &st) != 0 ? errno : 0;
+  if (stat_error != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd_);  // no destructor runs after a constructor throws
+    if (stat_error != 0) fail_errno(name_, "cannot stat", stat_error);
+    if (S_ISDIR(st.st_mode)) {
+      throw Error(Exit::bad_input, fmt::format("{}: is a directory, expected a file", name_));
+    }
+    // A device or FIFO may never end (/dev/zero, a pipe from `yes`): reading it whole would
+    // fill the memory, so only regular files are read.
     throw Error(
         Exit::bad_input,
         fmt::format("{}: not a regular file (a device, FIFO or socket); give a file", name_));
   }
-  if (S_ISREG(st.st_mode) && st.st_size > 0) {
-    size_ = static_cast<std::size_t>(st.st_size);
+  size_ = static_cast<std::uint64_t>(st.st_size);
+}
+
+InputFile::~InputFile() {
+  ::close(fd_);
+}
+
+void InputFile::read_at(std::uint64_t offset, void* data, std::size_t bytes) const {
+  auto* out = static_cast<char*>(data);
+  for (std::size_t done = 0; done < bytes;) {
+    const ssize_t n = ::pread(fd_, out + done, bytes - done, static_cast<off_t>(offset + done));
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) fail_errno(name_, "cannot read", errno);
+    if (n == 0) {
+      throw Error(Exit::bad_input,
+                  fmt::format("{}: truncated while it was read ({} bytes wanted at {})", name_,
+                              bytes, offset));
+    }
+    done += static_cast<std::size_t>(n);
+  }
+}
+
+MappedFile::MappedFile(const std::filesystem::path& path, MapMode mode)
+    : name_(path.string()), mode_(mode) {
+  const InputFile file(path);
+  const int fd = file.fd();
+  if (file.size() > 0) {
+    size_ = static_cast<std::size_t>(file.size());
     const int populate = mode == MapMode::whole ? MAP_POPULATE : 0;
     void* map = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | populate, fd, 0);
     if (map == MAP_FAILED) fail_errno(name_, "cannot map", errno);

@@ -8,12 +8,37 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace g2s::io {
+
+// A regular file opened read-only, as every reader opens its input: a missing file, a directory,
+// a device, FIFO or socket (which may never end), or a file it may not read throws
+// Error(bad_input) naming it. MappedFile maps one; the tile store reads its blocks with read_at.
+class InputFile {
+ public:
+  explicit InputFile(const std::filesystem::path& path);
+  ~InputFile();
+  InputFile(const InputFile&) = delete;
+  InputFile& operator=(const InputFile&) = delete;
+
+  int fd() const { return fd_; }
+  std::uint64_t size() const { return size_; }  // as stat gave it when opened
+  const std::string& name() const { return name_; }
+
+  // Reads [offset, offset + bytes) into `data`; throws Error(bad_input) if the file ends first
+  // (it shrank since it was opened) or the read fails.
+  void read_at(std::uint64_t offset, void* data, std::size_t bytes) const;
+
+ private:
+  std::string name_;
+  int fd_ = -1;
+  std::uint64_t size_ = 0;
+};
 
 // whole: every page is read in at once (fastest when the caller keeps the whole cloud anyway).
 // stream: pages are read in as touched, and release_before() drops the consumed ones.
@@ -38,9 +63,9 @@ class MappedFile {
   // process's resident set (they stay in the page cache). Const because the view is unchanged:
   // a page touched again is read back in. A no-op in whole mode.
   void release_before(std::size_t offset) const;
-  // Stream or random mode: the pages overlapping [begin, end) leave the resident set (for random
-  // access, e.g. a tile store's blocks; safe while other threads read them, or read the
-  // neighbouring bytes of a page on the edge: they are read back in).
+  // Stream or random mode: the pages overlapping [begin, end) leave the resident set (safe while
+  // other threads read them, or the neighbouring bytes of a page on the edge: they are read back
+  // in).
   void release(std::size_t begin, std::size_t end) const;
 
  private:

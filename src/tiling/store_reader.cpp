@@ -4,14 +4,10 @@
 // resident after every load (the kernel maps whole page-cache folios around a fault, up to 2 MiB,
 // beyond any margin a release could guess), and held 44% of the store at small budgets. Nothing
 // is modified after opening, so loads from several threads need no locking.
-#include <fcntl.h>
 #include <fmt/core.h>
-#include <sys/stat.h>
-#include <unistd.h>
 #include <zstd.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -19,6 +15,7 @@
 
 #include "g2s/error.hpp"
 #include "g2s/tile_store.hpp"
+#include "io/mapped_file.hpp"
 #include "tiling/store_format.hpp"
 #include "tiling/xxhash64.hpp"
 
@@ -39,75 +36,11 @@ ZSTD_DCtx* thread_decompressor() {
   return holder.context;
 }
 
-// A tile store opened for reading at offsets. Opening problems (missing, directory, device,
-// permission) throw Error(bad_input) naming the file, as the point readers do.
-class StoreFile {
- public:
-  explicit StoreFile(const std::filesystem::path& path) : name_(path.string()) {
-    fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd_ < 0) fail_errno("cannot open", errno);
-    struct stat st {};
-    if (::fstat(fd_, &st) != 0) fail_closing("cannot stat", errno);
-    if (S_ISDIR(st.st_mode)) fail_closing("is a directory, expected a file", 0);
-    if (!S_ISREG(st.st_mode)) fail_closing("not a regular file (a device, FIFO or socket)", 0);
-    size_ = static_cast<std::uint64_t>(st.st_size);
-  }
-  ~StoreFile() { ::close(fd_); }
-  StoreFile(const StoreFile&) = delete;
-  StoreFile& operator=(const StoreFile&) = delete;
-
-  const std::string& name() const { return name_; }
-  std::uint64_t size() const { return size_; }
-
-  // Reads [offset, offset + bytes) into `out` (resized to fit); the caller checked that the range
-  // lies in the file as opened, so a short read means the file shrank since.
-  void read(std::uint64_t offset, std::uint64_t bytes, std::vector<unsigned char>& out) const {
-    out.resize(bytes);
-    std::uint64_t done = 0;
-    while (done < bytes) {
-      const ssize_t n =
-          ::pread(fd_, out.data() + done, bytes - done, static_cast<off_t>(offset + done));
-      if (n < 0 && errno == EINTR) continue;
-      if (n < 0) fail_errno("cannot read", errno);
-      if (n == 0) {
-        throw Error(Exit::bad_input,
-                    fmt::format("{}: truncated while it was read ({} bytes wanted at {})", name_,
-                                bytes, offset));
-      }
-      done += static_cast<std::uint64_t>(n);
-    }
-  }
-
- private:
-  [[noreturn]] void fail_errno(const char* what, int err) const {
-    throw Error(Exit::bad_input, err ? fmt::format("{}: {}: {}", name_, what, std::strerror(err))
-                                     : fmt::format("{}: {}", name_, what));
-  }
-  [[noreturn]] void fail_closing(const char* what, int err) const {
-    ::close(fd_);  // no destructor runs after a constructor throws
-    fail_errno(what, err);
-  }
-
-  std::string name_;
-  int fd_ = -1;
-  std::uint64_t size_ = 0;
-};
-
-// Per-thread scratch for the stored bytes of a frame table and of a frame.
-std::vector<unsigned char>& thread_table_bytes() {
-  thread_local std::vector<unsigned char> bytes;
-  return bytes;
-}
-std::vector<unsigned char>& thread_frame_bytes() {
-  thread_local std::vector<unsigned char> bytes;
-  return bytes;
-}
-
 }  // namespace
 
 struct TileStore::Impl {
   std::filesystem::path path;
-  StoreFile file;
+  io::InputFile file;
   bool compressed = false;
   std::uint64_t frame_points = 0;
   std::uint64_t point_count = 0;
@@ -120,6 +53,12 @@ struct TileStore::Impl {
   std::vector<std::uint64_t> frame_table_checksum;
 
   explicit Impl(const std::filesystem::path& store) : path(store), file(store) {}
+
+  // Reads [offset, offset + bytes) of the store into `out`.
+  void read(std::uint64_t offset, std::uint64_t bytes, std::vector<unsigned char>& out) const {
+    out.resize(bytes);
+    file.read_at(offset, out.data(), bytes);
+  }
 
   template <typename... Args>
   [[noreturn]] void fail(fmt::format_string<Args...> format, Args&&... args) const {
@@ -137,7 +76,7 @@ void TileStore::Impl::open() {
   const std::uint64_t size = file.size();
   if (size == 0) fail("file is empty (expected a g2s tile store)");
   std::vector<unsigned char> header_bytes_read;
-  file.read(0, std::min<std::uint64_t>(size, kHeaderBytes), header_bytes_read);
+  read(0, std::min<std::uint64_t>(size, kHeaderBytes), header_bytes_read);
   const unsigned char* h = header_bytes_read.data();
   if (std::memcmp(h, kMagic, std::min<std::uint64_t>(size, sizeof kMagic)) != 0) {
     fail("not a g2s tile store (it does not start with the magic bytes 'G2STILES')");
@@ -195,7 +134,7 @@ void TileStore::Impl::open() {
          tile_count, table_bytes, table_offset, size);
   }
   std::vector<unsigned char> table;
-  file.read(table_offset, table_bytes, table);
+  read(table_offset, table_bytes, table);
   if (xxhash64(table.data(), table_bytes) != load_le<std::uint64_t>(h + header::table_checksum)) {
     fail("tile table checksum mismatch (the table is corrupt)");
   }
@@ -264,10 +203,10 @@ const unsigned char* TileStore::Impl::frame_table(std::size_t tile) const {
     throw Error(Exit::failure, fmt::format("{}: tile {} asked for; the store has {} tiles",
                                            file.name(), tile, tiles.size()));
   }
-  std::vector<unsigned char>& table = thread_table_bytes();
+  thread_local std::vector<unsigned char> table;
   const std::uint64_t table_bytes =
       frame_count(tiles[tile].points, frame_points) * kFrameEntryBytes;
-  file.read(block_offset[tile], table_bytes, table);
+  read(block_offset[tile], table_bytes, table);
   if (xxhash64(table.data(), table_bytes) != frame_table_checksum[tile]) {
     fail("tile {}: frame table checksum mismatch (the block is corrupt)", tile);
   }
@@ -283,8 +222,7 @@ TilePoints TileStore::Impl::decode(std::size_t tile, const unsigned char* table,
   TilePoints out;
   out.xyz.resize(points * 3);
   out.ids.resize(points);
-  std::vector<unsigned char>& stored = thread_frame_bytes();
-  thread_local std::vector<unsigned char> unpacked;
+  thread_local std::vector<unsigned char> stored, unpacked;
   std::uint64_t expected_offset = all_frames * kFrameEntryBytes;
   for (std::uint64_t f = 0; f < frames; ++f) {
     const unsigned char* e = table + f * kFrameEntryBytes;
@@ -295,7 +233,7 @@ TilePoints TileStore::Impl::decode(std::size_t tile, const unsigned char* table,
            stored_bytes, offset);
     }
     expected_offset += stored_bytes;
-    file.read(block_offset[tile] + offset, stored_bytes, stored);
+    read(block_offset[tile] + offset, stored_bytes, stored);
     if (xxhash64(stored.data(), stored_bytes) != load_le<std::uint64_t>(e + frame::checksum)) {
       fail("tile {} frame {}: checksum mismatch (the block is corrupt)", tile, f);
     }
