@@ -524,7 +524,7 @@ class Grower {
     loop_near_.clear();
     last_blocker_ = kNoIndex;
     cells.for_each_near(box.lo, box.hi, [&](std::uint32_t other, const detail::Box& near_box) {
-      if (!skip(other)) loop_near_.push_back({other, near_box, {{}, kBallUnknown}});
+      if (!skip(other)) loop_near_.push_back({other, near_box});
     });
   }
 
@@ -1140,8 +1140,7 @@ class Grower {
   bool fill_fits(const Triangle& t) {
     const detail::Box box = detail::box_of(grid_.points(), t);
     // Points this run may not use (a seam's context: tiles still to come) must not lie in
-    // the triangle's circumball: the surface may yet be meshed over them. The same (padded)
-    // ball settles most neighbours by the power test (detail::apart).
+    // the triangle's circumball: the surface may yet be meshed over them.
     Ball ball;
     if (!detail::padded_circumball(grid_.position(t[0]), grid_.position(t[1]), grid_.position(t[2]),
                                    ball)) {
@@ -1154,18 +1153,16 @@ class Grower {
       });
       if (covers_context) return false;
     }
-    const auto blocks = [&](NearTriangle& near) {
+    // Neighbours side by side with the candidate are mostly settled by its planes, built once
+    // a near triangle's box overlaps its box.
+    std::optional<detail::SeparatingPlanes> planes;
+    const auto blocks = [&](const NearTriangle& near) {
       if (!detail::overlap(box, near.box)) return false;
       const Triangle& o = triangles_[near.index];
-      // Most triangles near a loop overlap no candidate's box: their balls wait until one does.
-      if (near.ball.radius2 == kBallUnknown &&
-          !detail::padded_circumball(grid_.position(o[0]), grid_.position(o[1]),
-                                     grid_.position(o[2]), near.ball)) {
-        near.ball.radius2 = -1;  // none: apart() decides nothing, the exact test does
-      }
-      return std::is_permutation(o.begin(), o.end(), t.begin()) ||
-             (!detail::apart(grid_.points(), t, ball, o, near.ball) &&
-              detail::triangles_cross(grid_.points(), t, o));
+      if (!planes) planes.emplace(grid_.points(), t);
+      if (planes->separate(grid_.points(), o)) return false;
+      if (std::is_permutation(o.begin(), o.end(), t.begin())) return true;
+      return detail::triangles_cross(grid_.points(), t, o);
     };
     // The triangle that refused the last candidate is asked first: where the surface folds over
     // a hole, one grown triangle refuses most of the candidates across it.
@@ -1551,13 +1548,10 @@ class Grower {
   std::vector<WalkPoint> cand_;
   std::vector<Index> excluded_;  // points a retried edge has already failed with
   std::vector<std::pair<double, std::uint32_t>> near_;
-  // fill_holes: the grown triangles near the loop being filled, with their boxes and padded
-  // circumballs (radius2 -1: none; kBallUnknown: not computed yet)
-  static constexpr double kBallUnknown = -2;
+  // fill_holes: the grown triangles near the loop being filled, with their boxes
   struct NearTriangle {
     std::uint32_t index;
     detail::Box box;
-    Ball ball;
   };
   std::vector<NearTriangle> loop_near_;
   std::uint32_t last_blocker_ = kNoIndex;  // fill_fits: the place in loop_near_ that refused last
