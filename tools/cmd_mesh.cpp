@@ -3,6 +3,7 @@
 // the mesh written with a summary of its defects. `g2s tile`, `g2s grow` and `g2s stitch` run the
 // same stages as separate processes and give the same bytes.
 #include <fmt/core.h>
+#include <tbb/task_arena.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -247,7 +248,13 @@ void add_mesh_command(CLI::App& app) {
                   "time, content) with the same --tile-points, else tiles again");
   cmd->add_flag("--compress", args->compress, "zstd-compress the tile store");
   add_mesh_options(*cmd, args->options);
-  cmd->callback([args] { run_mesh(*args); });
+  // Every stage in one arena of --threads threads: the tiling and the output keep to the count
+  // too (a shared node's allocation), and the pipeline needs no arena of its own (mesh_tiles).
+  cmd->callback([args] {
+    tbb::task_arena(args->threads > 0 ? args->threads : tbb::task_arena::automatic).execute([&] {
+      run_mesh(*args);
+    });
+  });
 }
 
 }  // namespace g2s::cli
