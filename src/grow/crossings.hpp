@@ -6,12 +6,12 @@
 #pragma once
 
 #include <algorithm>
-#include <array>
 #include <cstdint>
 #include <span>
 #include <utility>
 #include <vector>
 
+#include "common/separating_planes.hpp"
 #include "common/vec3.hpp"
 #include "g2s/types.hpp"
 #include "grid/hash_grid.hpp"
@@ -66,40 +66,6 @@ inline Box box_of(std::span<const Vec3f> points, const Triangle& t) {
 // the pairs are the same for any thread count.
 std::vector<std::pair<std::uint32_t, std::uint32_t>> find_crossings(
     const HashGrid& grid, std::span<const Triangle> triangles);
-
-// A triangle's own plane and, through each of its edges, the plane square to it that faces away
-// from it: a convex set with every corner strictly beyond one of these planes, but for corners
-// the triangle shares on it, meets the triangle only in those shared corners (its points on the
-// plane are the hull of its corners there). So two triangles one of whose corners lie so can
-// never cross, and the exact test is not needed. This settles most pairs of neighbours side by side
-// in one surface, whose circumballs overlap (so that the argument of find_crossings does not
-// apply). "Strictly" is judged on the value computed in double with a margin: a point's side, n .
-// (p - corner), is a polynomial of degree 4 in coordinate differences of float corners (exact in
-// double), evaluated 7 roundings deep, so its error is below 16 units of roundoff times the same
-// polynomial over absolute values; the margin is 1e-13 of that (about 900 units), so no point on or
-// across a plane is ever taken as beyond it. Sharing is by index (a grid holds no two equal
-// positions).
-class SeparatingPlanes {
- public:
-  SeparatingPlanes(std::span<const Vec3f> points, const Triangle& t);
-  // True when `other`'s corners that t lacks all lie strictly beyond one of t's planes (on the
-  // same side of t's own plane, or beyond an edge's plane with only that edge's corners shared):
-  // then other and t do not cross. False decides nothing.
-  bool separate(std::span<const Vec3f> points, const Triangle& other) const;
-
- private:
-  // A plane through a corner of t: a point p is strictly beyond it when normal . (p - corner)
-  // exceeds kMargin times bound . |p - corner|.
-  struct Plane {
-    Vec3 normal, bound;
-  };
-  static constexpr double kMargin = 1e-13;
-  Triangle t_;
-  Vec3 corner0_, corner1_;
-  Plane face_;                  // through corner 0
-  std::array<Plane, 3> edges_;  // edge k runs from corner k to corner k + 1; 0 and 2 through
-                                // corner 0, 1 through corner 1
-};
 
 // Triangles filed by the cell of their bounding box's lower corner, in levels of cells each 8
 // times larger than the one before: a triangle is filed in the first level whose cell its box

@@ -1155,7 +1155,7 @@ class Grower {
     }
     // Neighbours side by side with the candidate are mostly settled by its planes, built once
     // a near triangle's box overlaps its box.
-    std::optional<detail::SeparatingPlanes> planes;
+    std::optional<SeparatingPlanes> planes;
     const auto blocks = [&](const NearTriangle& near) {
       if (!detail::overlap(box, near.box)) return false;
       const Triangle& o = triangles_[near.index];
