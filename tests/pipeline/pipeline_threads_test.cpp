@@ -1,13 +1,18 @@
 // `g2s mesh` gives the same bytes for any --threads, whatever --memory plans: the tile size comes
 // from the budget alone (the threads only change how many tiles are in flight). Checked on a real
 // scan and on a synthetic cloud cut into many tiles, at budgets where the plan of an earlier
-// version cut the cloud differently for each thread count.
+// version cut the cloud differently for each thread count. And the pipeline runs in an arena of
+// the threads asked for.
 #include <fmt/core.h>
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
+#include <array>
 #include <filesystem>
+#include <span>
 #include <string>
 
+#include "g2s/mesh_sink.hpp"
 #include "g2s/pipeline.hpp"
 #include "g2s/synth.hpp"
 #include "g2s/tile_store.hpp"
@@ -70,6 +75,39 @@ TEST_F(ThreadCount, SameBytesOnACloudOfManyTiles) {
   const fs::path cloud = dir_ / "torus.ply";
   g2s::write_synthetic_cloud(cloud.string(), o);
   expect_same_bytes(cloud, {"48M", "64M"}, 8);
+}
+
+// The tiles grow and stitch in an arena of options.threads threads: the caller's own when it has
+// that size (g2s mesh runs every stage in one), a new one otherwise.
+class ArenaSink final : public g2s::MeshSink {
+ public:
+  void vertex(g2s::Index, const double*) override {}
+  void triangle(const g2s::Triangle&, const std::array<const double*, 3>&, std::uint32_t) override {
+    concurrency = tbb::this_task_arena::max_concurrency();
+    ++triangles;
+  }
+  void finish(std::span<const std::uint8_t>) override {}
+  int concurrency = 0;
+  std::size_t triangles = 0;
+};
+
+TEST(MeshTiles, RunsInAnArenaOfTheThreadsAskedFor) {
+  g2s::SynthOptions o;
+  o.shape = g2s::SynthShape::torus;
+  o.points = 20000;
+  const g2s::PointCloud cloud = g2s::make_synthetic_cloud(o);
+  const g2s::MemoryTiles tiles(cloud, 4000);
+  const auto concurrency_in = [&](int caller, int threads) {
+    g2s::PipelineOptions options;
+    options.threads = threads;
+    ArenaSink sink;
+    tbb::task_arena(caller).execute([&] { g2s::mesh_tiles(tiles, options, sink); });
+    EXPECT_GT(sink.triangles, 30000u);
+    return sink.concurrency;
+  };
+  EXPECT_EQ(concurrency_in(3, 3), 3);
+  EXPECT_EQ(concurrency_in(3, 1), 1);
+  EXPECT_EQ(concurrency_in(1, 2), 2);
 }
 
 }  // namespace
