@@ -517,8 +517,8 @@ class Grower {
     return preloaded_ == 0 && root != kNoIndex;
   }
 
-  // Lists the grown triangles whose boxes overlap `box` in loop_near_ (their balls not yet
-  // computed), but those `skip` says, for fill_fits.
+  // Lists the grown triangles whose boxes overlap `box` in loop_near_, but those `skip` says,
+  // for fill_fits.
   template <class Skip>
   void gather_near(const detail::TriangleCells& cells, const detail::Box& box, Skip&& skip) {
     loop_near_.clear();
