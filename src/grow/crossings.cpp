@@ -11,6 +11,7 @@
 #include <cmath>
 
 #include "common/exact_predicates.hpp"
+#include "common/separating_planes.hpp"
 #include "common/triangle_intersection.hpp"
 
 namespace g2s::detail {

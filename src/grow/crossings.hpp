@@ -11,7 +11,6 @@
 #include <utility>
 #include <vector>
 
-#include "common/separating_planes.hpp"
 #include "common/vec3.hpp"
 #include "g2s/types.hpp"
 #include "grid/hash_grid.hpp"

@@ -19,6 +19,7 @@
 
 #include "cleanup/cleanup.hpp"
 #include "common/edge_map.hpp"
+#include "common/separating_planes.hpp"
 #include "common/union_find.hpp"
 #include "grow/bucket_queue.hpp"
 #include "grow/crossings.hpp"

@@ -20,13 +20,6 @@ namespace {
 std::array<Vec3, 3> corners(const std::vector<Vec3f>& points, const Triangle& t) {
   return {Vec3(points[t[0]]), Vec3(points[t[1]]), Vec3(points[t[2]])};
 }
-SeparatingPlanes planes_of(const std::vector<Vec3f>& points, const Triangle& t) {
-  return SeparatingPlanes(points, t);
-}
-bool settles(const SeparatingPlanes& planes, const std::vector<Vec3f>& points,
-             const Triangle& other) {
-  return planes.separate(points, other);
-}
 bool cross(const std::vector<Vec3f>& points, const Triangle& a, const Triangle& b) {
   const std::array<Vec3, 3> pa = corners(points, a), pb = corners(points, b);
   return triangles_cross(pa.data(), pb.data());
@@ -48,15 +41,15 @@ TEST(SeparatingPlanes, SettleNeighboursInOneSurfaceButNeverACrossing) {
                                      {0.5f, 0, 0}, {0.7f, 0.2f, -1}, {0.7f, 0.2f, 1}, {0.5f, -1, 0},
                                      {0, 1, 1},    {0.7f, 0.2f, 0}};
   const Triangle half{0, 1, 2};
-  const SeparatingPlanes planes = planes_of(points, half);
-  EXPECT_TRUE(settles(planes, points, {0, 2, 3}));    // the other half, across the shared edge
-  EXPECT_TRUE(settles(planes, points, {1, 4, 5}));    // beside it, one shared corner
-  EXPECT_TRUE(settles(planes, points, {6, 7, 12}));   // above its plane
-  EXPECT_FALSE(settles(planes, points, {0, 2, 4}));   // folded flat onto it
-  EXPECT_FALSE(settles(planes, points, {9, 10, 3}));  // piercing it
-  EXPECT_FALSE(settles(planes, points, {8, 11, 4}));  // a corner on its edge 0-1
-  EXPECT_FALSE(settles(planes, points, {6, 7, 13}));  // a corner on its face, the rest above
-  EXPECT_FALSE(settles(planes, points, {2, 0, 1}));   // itself
+  const SeparatingPlanes planes(points, half);
+  EXPECT_TRUE(planes.separate(points, {0, 2, 3}));    // the other half, across the shared edge
+  EXPECT_TRUE(planes.separate(points, {1, 4, 5}));    // beside it, one shared corner
+  EXPECT_TRUE(planes.separate(points, {6, 7, 12}));   // above its plane
+  EXPECT_FALSE(planes.separate(points, {0, 2, 4}));   // folded flat onto it
+  EXPECT_FALSE(planes.separate(points, {9, 10, 3}));  // piercing it
+  EXPECT_FALSE(planes.separate(points, {8, 11, 4}));  // a corner on its edge 0-1
+  EXPECT_FALSE(planes.separate(points, {6, 7, 13}));  // a corner on its face, the rest above
+  EXPECT_FALSE(planes.separate(points, {2, 0, 1}));   // itself
   for (const Triangle& o : std::vector<Triangle>{{0, 2, 4}, {9, 10, 3}, {8, 11, 4}, {6, 7, 13}}) {
     EXPECT_TRUE(cross(points, half, o));
   }
@@ -98,7 +91,7 @@ TEST(SeparatingPlanes, NeverSeparateTrianglesThatCross) {
     if (shared == 2) b[1] = 2;
     if (collinear(points, a) || collinear(points, b)) continue;
     const bool crosses = cross(points, a, b);
-    const bool settled = settles(planes_of(points, a), points, b);
+    const bool settled = SeparatingPlanes(points, a).separate(points, b);
     ASSERT_FALSE(crosses && settled) << "trial " << trial;
     crossing += crosses;
     apart += !crosses;
@@ -106,6 +99,18 @@ TEST(SeparatingPlanes, NeverSeparateTrianglesThatCross) {
   }
   EXPECT_GT(crossing, 10000u);
   EXPECT_GT(separated, apart * 3 / 4);
+}
+
+TEST(SeparatingPlanes, DecideNothingWhereProductsCouldUnderOrOverflow) {
+  // The other half of a square across the shared diagonal, in double: settled at scale 1, not
+  // where coordinate differences fall below 1e-60 or above 1e60 (the margin would no longer
+  // bound the rounding).
+  for (const double scale : {1.0, 1e-70, 1e70}) {
+    const std::vector<Vec3> points = {{0, 0, 0}, {scale, 0, 0}, {scale, scale, 0}, {0, scale, 0}};
+    const auto position = [&](Index v) { return points[v]; };
+    const SeparatingPlanes planes(Triangle{0, 1, 2}, position);
+    EXPECT_EQ(planes.separate(Triangle{0, 2, 3}, position), scale == 1.0) << scale;
+  }
 }
 
 }  // namespace

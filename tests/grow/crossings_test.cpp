@@ -9,6 +9,7 @@
 
 #include <random>
 
+#include "common/separating_planes.hpp"
 #include "grid/hash_grid.hpp"
 
 namespace g2s {
