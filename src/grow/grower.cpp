@@ -303,14 +303,16 @@ class Grower {
   // Once growth is over: no crossing triangles, small holes filled, and the points with more
   // than one fan left to a single one, with the holes that leaves filled in turn
   // (docs/algorithm.md, "No crossing triangles" and "Hole filling"). Filling first lets a hole
-  // between two fans of a point join them, where deleting one fan would leave a larger hole.
-  // Then scraps of surface near the rest go (remove_scraps), and last a piece whose only border
-  // is a short loop is closed with a point left over, where that makes a closed surface
+  // between two fans of a point join them, where deleting one fan would leave a larger hole;
+  // such a gap is not widened in that first round (most widenings of one fail, at a tenth of the
+  // run on alpe): the non-manifold pass keeps one fan, and the second round widens what that
+  // leaves. Then scraps of surface near the rest go (remove_scraps), and last a piece whose only
+  // border is a short loop is closed with a point left over, where that makes a closed surface
   // (cap_single_loops).
   void finish_surface() {
     compact(remove_crossings());
     if (options_.max_hole_edges < 3) return;
-    fill_small_holes();
+    fill_small_holes(/*widen_fan_gaps=*/false);
     // Points whose whole star is in this run: growable, and no corner of a triangle kept from
     // before (the clean-up of the tiled pipeline judges those).
     std::vector<std::uint8_t> judged(grid_.size(), 0);
@@ -328,7 +330,7 @@ class Grower {
         for (Index v : triangles_[t]) second_fans_.push_back(v);
       }
       compact(std::move(dead));
-      fill_small_holes();
+      fill_small_holes(/*widen_fan_gaps=*/true);
     }
     if (options_.max_hole_rings > 0) remove_scraps();
     cap_single_loops();
@@ -621,10 +623,10 @@ class Grower {
   }
 
   // One round of hole filling (fill_holes) and the removal of fillings that cross each other.
-  void fill_small_holes() {
+  void fill_small_holes(bool widen_fan_gaps) {
     const auto grown = static_cast<std::uint32_t>(triangles_.size());
     std::vector<std::uint8_t> dead(grown, 0);
-    fill_holes(dead);
+    fill_holes(dead, widen_fan_gaps);
     dead.resize(triangles_.size(), 0);
     remove_crossing_fills(grown, dead);
     compact(std::move(dead));
@@ -666,9 +668,11 @@ class Grower {
   // own, and filling it makes the two fans one; a loop through a point twice is split there.
   // A hole that cannot be filled so (most often because the surface around it folds over it) is
   // widened ring by ring (widen) and filled in place of the rings, if it then can be and the
-  // points that leaves out lie close to the surface (leaves_out_only_near). Appends the filling
-  // triangles to triangles_ and marks the rings kUnlinked in `dead` (sized as triangles_).
-  void fill_holes(std::vector<std::uint8_t>& dead) {
+  // points that leaves out lie close to the surface (leaves_out_only_near); a loop through a
+  // point with several open fans (a gap between them) only with widen_fan_gaps. Appends the
+  // filling triangles to triangles_ and marks the rings kUnlinked in `dead` (sized as
+  // triangles_).
+  void fill_holes(std::vector<std::uint8_t>& dead, bool widen_fan_gaps) {
     // The grown triangles filed for the crossing test, once a loop needs them. The fillings wait
     // in `filled` until every loop is done, so that the filed triangles stay where they are.
     std::optional<detail::TriangleCells> cells;
@@ -689,6 +693,9 @@ class Grower {
       }
     }
     const std::vector<std::uint32_t> next = next_open_edges(open);
+    // Per point, its open fans (the open edges leaving it), counted up to two.
+    std::vector<std::uint8_t> open_fans(grid_.size(), 0);
+    for (const OpenEdge& e : open) open_fans[e.from] = open_fans[e.from] == 0 ? 1 : 2;
     const auto max_edges =
         static_cast<std::size_t>(std::min(options_.max_hole_edges, MeshOptions::kMaxHoleEdges));
     const int max_rings = std::clamp(options_.max_hole_rings, 0, MeshOptions::kMaxHoleRings);
@@ -783,7 +790,9 @@ class Grower {
       }
       if (!cells) cells.emplace(grid_.points(), std::span<const Triangle>(triangles_));
       bool done = try_fill(*cells, attempt, scratch, fill);
-      for (int round = 0; !done && round < max_rings; ++round) {
+      const bool widens = widen_fan_gaps || std::none_of(attempt.loop.begin(), attempt.loop.end(),
+                                                         [&](Index v) { return open_fans[v] > 1; });
+      for (int round = 0; !done && widens && round < max_rings; ++round) {
         if (!widen(*cells, attempt, holes, dead, max_edges)) break;
         done =
             try_fill(*cells, attempt, scratch, fill) && leaves_out_only_near(attempt, fill, dead);

@@ -158,12 +158,14 @@ TEST(RealScanGaps, WideningHolesLeavesFewerHolesAndOnlyPointsNearTheSurfaceOut) 
 // them when the mesher improves. closed-bunny-zipper is closed now that the small holes the scan
 // leaves in its base are filled. Widened holes and removed scraps (MeshOptions::max_hole_rings)
 // leave out points near the surface: the noisy scans' coverage fell by 0.1 to 0.8 points.
+// raw-bunny's were measured again (780 -> 817 holes) when gaps between two fans of a point
+// stopped being widened before the non-manifold pass (docs/algorithm.md, "Hole filling").
 INSTANTIATE_TEST_SUITE_P(
     SharedData, RealScan,
     ::testing::Values(Baseline{"closed-kitten", true, 0.995, 0, 0, 0.995},
                       Baseline{"closed-bunny-zipper", true, 0.995, 8, 1, 0.995},
                       Baseline{"open-bunny-scan-bun000", false, 0.9977, 690, 7, 0.995},
-                      Baseline{"raw-bunny", false, 0.9813, 18192, 819, 0.97},
+                      Baseline{"raw-bunny", false, 0.9835, 18813, 858, 0.97},
                       Baseline{"open-table-mug-stereo", false, 0.9923, 5205, 79, 0.97},
                       Baseline{"open-lion-photogrammetry", false, 0.9921, 16624, 490, 0.97},
                       Baseline{"open-autzen-lidar", false, 0.9886, 10090, 264, 0.995},
