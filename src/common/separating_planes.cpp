@@ -7,7 +7,6 @@ namespace g2s {
 SeparatingPlanes::SeparatingPlanes(std::span<const Vec3f> points, const Triangle& t)
     : SeparatingPlanes(t, [&](Index v) { return Vec3(points[v]); }) {
   checks_range_ = false;  // differences of floats lie between 1.4e-45 and 6.9e38
-  usable_ = true;
 }
 
 bool SeparatingPlanes::separate(std::span<const Vec3f> points, const Triangle& other) const {

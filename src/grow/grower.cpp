@@ -790,9 +790,12 @@ class Grower {
       }
       if (!cells) cells.emplace(grid_.points(), std::span<const Triangle>(triangles_));
       bool done = try_fill(*cells, attempt, scratch, fill);
-      const bool widens = widen_fan_gaps || std::none_of(attempt.loop.begin(), attempt.loop.end(),
-                                                         [&](Index v) { return open_fans[v] > 1; });
-      for (int round = 0; !done && widens && round < max_rings; ++round) {
+      const auto through_fan_gap = [&] {
+        return std::any_of(attempt.loop.begin(), attempt.loop.end(),
+                           [&](Index v) { return open_fans[v] > 1; });
+      };
+      const bool widens = !done && (widen_fan_gaps || !through_fan_gap());
+      for (int round = 0; widens && !done && round < max_rings; ++round) {
         if (!widen(*cells, attempt, holes, dead, max_edges)) break;
         done =
             try_fill(*cells, attempt, scratch, fill) && leaves_out_only_near(attempt, fill, dead);
