@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "g2s/mesh_sink.hpp"
@@ -70,23 +71,49 @@ struct PipelineSummary {
   // The most points the stitcher held at once: the band of unfinished seams, not the cloud.
   std::uint64_t peak_live_points = 0;
   double seconds_stitch = 0.0;
-  // CPU seconds (thread clocks) of mesh_tiles' stages: growing, summed over the tiles, and the
-  // stitcher's intake of the tiles (seams, clean-up, and the sink's work as triangles go out).
+  // CPU seconds (thread clocks) of mesh_tiles' stages: growing and preparing (Stitcher::prepare),
+  // summed over the tiles, and the stitcher's serial intake of the tiles (Stitcher::add: seams,
+  // clean-up, and the sink's work as triangles go out).
   double cpu_seconds_grow = 0.0;
   double cpu_seconds_stitch = 0.0;
+};
+
+// A grown tile made ready for Stitcher::add by Stitcher::prepare: its points, and what the
+// stitcher needs to know of them that does not depend on the tiles stitched before it.
+class PreparedTile {
+ public:
+  PreparedTile();
+  ~PreparedTile();
+  PreparedTile(PreparedTile&&) noexcept;
+  PreparedTile& operator=(PreparedTile&&) noexcept;
+
+ private:
+  friend class Stitcher;
+  struct Data;
+  std::unique_ptr<Data> data_;
 };
 
 // The seam stitcher and the global clean-up, fed tile by tile in index order (as tiles finish
 // growing). A vertex is finished once every tile that could still touch it has been stitched:
 // then its non-manifold fans are removed, and each triangle whose corners are all finished goes
 // to the sink and leaves memory. finish() decides the orientation of the groups.
+//
+// Taking a tile in has two parts. prepare() does the work that needs only the tile and the
+// tile layout: which points a later seam can reach and when each is finished and released, and
+// the final triangles numbered and laid out as they will go to the sink. It reads nothing the
+// stitcher changes, so several tiles may be prepared at once, on other threads, while add()
+// runs (the pipeline prepares a tile where it grew). add() does the rest, in index order: the
+// final triangles to the sink, the other triangles into the live mesh, the seams, the clean-up.
 class Stitcher {
  public:
   Stitcher(const TileSource& source, const PipelineOptions& options, MeshSink& sink);
   ~Stitcher();
   Stitcher(const Stitcher&) = delete;
   Stitcher& operator=(const Stitcher&) = delete;
-  void add(std::size_t tile, TileGrowth growth);  // tile = 0, 1, 2, ...
+  // Throws Error(bad_input) if the growth does not fit the tile (a corner or id out of range).
+  PreparedTile prepare(std::size_t tile, TileGrowth growth) const;
+  void add(std::size_t tile, PreparedTile prepared);  // tile = 0, 1, 2, ...
+  void add(std::size_t tile, TileGrowth growth) { add(tile, prepare(tile, std::move(growth))); }
   PipelineSummary finish();
 
  private:

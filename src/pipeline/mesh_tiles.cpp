@@ -53,8 +53,9 @@ std::uint64_t thread_cpu_ns() {
 PipelineSummary mesh_tiles(const TileSource& source, const PipelineOptions& options,
                            MeshSink& sink) {
   const int wanted = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
-  // Tiles grow in parallel while the stitcher, one tile at a time in index order, closes the
-  // seams of those already grown; tiles_in_flight bounds the tiles grown and waiting.
+  // Tiles grow (and are prepared for the stitcher) in parallel while the stitcher, one tile at a
+  // time in index order, closes the seams of those already grown; tiles_in_flight bounds the
+  // tiles grown and waiting.
   const std::size_t tiles = source.tiles().size();
   const auto workers = static_cast<std::size_t>(wanted);
   Stitcher stitcher(source, options, sink);
@@ -69,16 +70,16 @@ PipelineSummary mesh_tiles(const TileSource& source, const PipelineOptions& opti
                                               if (next == tiles) control.stop();
                                               return next++;
                                             }) &
-            tbb::make_filter<std::size_t, std::pair<std::size_t, TileGrowth>>(
+            tbb::make_filter<std::size_t, std::pair<std::size_t, PreparedTile>>(
                 tbb::filter_mode::parallel,
                 [&](std::size_t t) {
                   const std::uint64_t start = thread_cpu_ns();
-                  std::pair grown{t, grow_tile(source, t, options)};
+                  std::pair grown{t, stitcher.prepare(t, grow_tile(source, t, options))};
                   grow_ns += thread_cpu_ns() - start;
                   return grown;
                 }) &
-            tbb::make_filter<std::pair<std::size_t, TileGrowth>, void>(
-                tbb::filter_mode::serial_in_order, [&](std::pair<std::size_t, TileGrowth> grown) {
+            tbb::make_filter<std::pair<std::size_t, PreparedTile>, void>(
+                tbb::filter_mode::serial_in_order, [&](std::pair<std::size_t, PreparedTile> grown) {
                   const std::uint64_t start = thread_cpu_ns();
                   stitcher.add(grown.first, std::move(grown.second));
                   stitch_ns += thread_cpu_ns() - start;

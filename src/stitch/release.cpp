@@ -7,7 +7,6 @@
 #include <utility>
 
 namespace g2s {
-namespace {
 
 void add_to_sums(GroupSums& s, const std::array<const double*, 3>& xyz, const Vec3& origin,
                  const Triangle& ids) {
@@ -19,8 +18,6 @@ void add_to_sums(GroupSums& s, const std::array<const double*, 3>& xyz, const Ve
   s.corners += 3;
   s.edge_keys ^= edge_key(ids[0], ids[1]) ^ edge_key(ids[1], ids[2]) ^ edge_key(ids[2], ids[0]);
 }
-
-}  // namespace
 
 void emit_triangle(const std::array<std::uint32_t*, 3>& number,
                    const std::array<const double*, 3>& xyz, const Triangle& ids, GroupSums& sums,

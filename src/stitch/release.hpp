@@ -17,9 +17,13 @@ struct ReleaseCounts {
   std::uint32_t vertices = 0;   // numbered so far
 };
 
-// Hands one triangle to the sink: corners without a vertex number (kNoIndex in *number[k]) get
-// the next one, in order of first use; the triangle joins its group's orientation sums. origin:
+// Adds triangle `ids` with corner positions `xyz` to its group's orientation sums. origin:
 // subtracted from positions in the sums (the cloud's centre, so they keep their precision).
+void add_to_sums(GroupSums& sums, const std::array<const double*, 3>& xyz, const Vec3& origin,
+                 const Triangle& ids);
+
+// Hands one triangle to the sink: corners without a vertex number (kNoIndex in *number[k]) get
+// the next one, in order of first use; the triangle joins its group's orientation sums.
 void emit_triangle(const std::array<std::uint32_t*, 3>& number,
                    const std::array<const double*, 3>& xyz, const Triangle& ids, GroupSums& sums,
                    std::uint32_t group, const Vec3& origin, MeshSink& sink, ReleaseCounts& counts);

@@ -345,99 +345,179 @@ Stitcher::Stitcher(const TileSource& source, const PipelineOptions& options, Mes
 
 Stitcher::~Stitcher() = default;
 
-void Stitcher::add(std::size_t tile, TileGrowth growth) {
+struct PreparedTile::Data {
+  // A point the live mesh must hold: a seam can reach it, or it is a corner of a triangle that
+  // is not final, or it may have a second fan. `number`: its vertex number among the final
+  // triangles' corners (below), or kNoIndex.
+  struct Held {
+    double xyz[3];
+    Index id;
+    std::uint32_t finish;   // the step that finishes it
+    std::uint32_t release;  // the step that releases it
+    std::uint32_t number;
+    bool listed;  // a seam can look it up by id
+  };
+  std::vector<Held> held;
+  // The grown triangles: the first final_triangles (final) with their corners numbered from 0
+  // in order of first use, the others by their corners' places in `held`; second_fans too.
+  TileGrowth growth;
+  // The final triangles' corners in that order, so that the sink reads them in sequence, and
+  // (triangle, number) of the corners only final triangles use, each after its last triangle.
+  std::vector<Index> vertex_ids;
+  std::vector<double> vertex_xyz;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> done;
+  std::vector<GroupSums> sums;  // per group of the tile, over its final triangles
+};
+
+PreparedTile::PreparedTile() = default;
+PreparedTile::~PreparedTile() = default;
+PreparedTile::PreparedTile(PreparedTile&&) noexcept = default;
+PreparedTile& PreparedTile::operator=(PreparedTile&&) noexcept = default;
+
+PreparedTile Stitcher::prepare(std::size_t tile, TileGrowth growth) const {
+  const Impl& m = *impl_;
+  const std::span<const TileInfo> tiles = m.source.tiles();
+  const TilePoints points =
+      growth.points.size() == growth.report.points ? std::move(growth.points) : m.source.load(tile);
+  growth.points = TilePoints{};
+  const std::size_t n = points.size();
+  if (n != growth.report.points) {
+    throw Error(Exit::bad_input, "grown tile: its point count differs from the tile store's");
+  }
+  for (const Triangle& t : growth.triangles) {
+    for (Index v : t) {
+      if (v >= n) throw Error(Exit::bad_input, "grown tile: a corner is not a point of its tile");
+    }
+  }
+  for (Index v : growth.second_fans) {
+    if (v >= n) throw Error(Exit::bad_input, "grown tile: a corner is not a point of its tile");
+  }
+  for (Index id : points.ids) {
+    if (id >= m.source.point_count()) {
+      throw Error(Exit::bad_input, "tile store: a point id is out of range");
+    }
+  }
+  PreparedTile prepared;
+  prepared.data_ = std::make_unique<PreparedTile::Data>();
+  PreparedTile::Data& d = *prepared.data_;
+  // Per point: its place in d.held, or kNoIndex. First the corners of the triangles that are
+  // not final and the suspects (marked 0), then the points a seam can reach.
+  std::vector<std::uint32_t> held_at(n, kNoIndex);
+  for (std::size_t k = growth.final_triangles; k < growth.triangles.size(); ++k) {
+    for (Index v : growth.triangles[k]) held_at[v] = 0;
+  }
+  for (Index v : growth.second_fans) held_at[v] = 0;
+  std::vector<std::size_t> later;
+  double inside = 0;
+  for (std::size_t j = tile + 1; j < tiles.size(); ++j) {
+    const double far = m.reach[j].touch + m.reach[j].margin;
+    if (tiles[j].points > 0 && box_gap(tiles[tile].box, tiles[j].box) <= far) {
+      later.push_back(j);
+      inside = std::max(inside, far);
+    }
+  }
+  // Deeper than this, a point is out of reach of this tile's seams, even as the far corner of a
+  // live triangle touching the band (the longest edge: the margin).
+  const double unreachable = m.reach[tile].touch + m.reach[tile].margin;
+  // Each point's release step, and whether a seam can look it up, known before the final
+  // triangles go out: a point only they use is announced done to the sink right after its last
+  // one (a sink counting defects in stride then holds few points open).
+  for (std::size_t k = 0; k < n; ++k) {
+    const double* p = &points.xyz[3 * k];
+    const std::uint32_t release = m.last_step(tile, p, later, inside, true);
+    const bool listed = release != tile || box_depth(tiles[tile].box, p) <= unreachable;
+    if (!listed && held_at[k] == kNoIndex) continue;
+    const std::uint32_t finish =
+        release == tile ? release : m.last_step(tile, p, later, inside, false);
+    held_at[k] = static_cast<std::uint32_t>(d.held.size());
+    d.held.push_back({{p[0], p[1], p[2]}, points.ids[k], finish, release, kNoIndex, listed});
+  }
+  // The final triangles numbered as emit_triangle would number them, in order.
+  const std::size_t finals = growth.final_triangles;
+  std::vector<std::uint32_t> last_final(n, kNoIndex);
+  for (std::size_t k = 0; k < finals; ++k) {
+    for (Index v : growth.triangles[k]) last_final[v] = static_cast<std::uint32_t>(k);
+  }
+  std::vector<std::uint32_t> number(n, kNoIndex);
+  d.sums.resize(growth.groups);
+  for (std::size_t k = 0; k < finals; ++k) {
+    Triangle& t = growth.triangles[k];
+    add_to_sums(d.sums[growth.group[k]],
+                {&points.xyz[3 * std::size_t{t[0]}], &points.xyz[3 * std::size_t{t[1]}],
+                 &points.xyz[3 * std::size_t{t[2]}]},
+                m.origin, {points.ids[t[0]], points.ids[t[1]], points.ids[t[2]]});
+    for (Index& v : t) {
+      const Index point = v;
+      if (number[point] == kNoIndex) {
+        number[point] = static_cast<std::uint32_t>(d.vertex_ids.size());
+        d.vertex_ids.push_back(points.ids[point]);
+        d.vertex_xyz.insert(d.vertex_xyz.end(), &points.xyz[3 * std::size_t{point}],
+                            &points.xyz[3 * std::size_t{point} + 3]);
+        if (held_at[point] != kNoIndex) d.held[held_at[point]].number = number[point];
+      }
+      v = number[point];
+      if (last_final[point] == k && held_at[point] == kNoIndex) {
+        d.done.emplace_back(static_cast<std::uint32_t>(k), number[point]);
+        last_final[point] = kNoIndex;
+      }
+    }
+  }
+  for (std::size_t k = finals; k < growth.triangles.size(); ++k) {
+    for (Index& v : growth.triangles[k]) v = held_at[v];
+  }
+  for (Index& v : growth.second_fans) v = held_at[v];
+  d.growth = std::move(growth);
+  return prepared;
+}
+
+void Stitcher::add(std::size_t tile, PreparedTile prepared) {
   Impl& m = *impl_;
   if (tile != m.next) throw Error(Exit::failure, "stitch: tiles must come in index order");
+  if (!prepared.data_) throw Error(Exit::failure, "stitch: a tile was not prepared");
   ++m.next;
   const auto start = std::chrono::steady_clock::now();
-  const std::span<const TileInfo> tiles = m.source.tiles();
+  const PreparedTile::Data& d = *prepared.data_;
+  const TileGrowth& growth = d.growth;
   LiveMesh& live = m.live;
   const auto base = static_cast<std::uint32_t>(live.groups.size());
-  for (std::uint32_t k = 0; k < growth.groups; ++k) live.add_group();
-  std::vector<std::uint32_t> slot_of_point;  // per tile point: its slot, or kNoIndex
-  {
-    const TilePoints points = growth.points.size() == growth.report.points
-                                  ? std::move(growth.points)
-                                  : m.source.load(tile);
-    if (points.size() != growth.report.points) {
-      throw Error(Exit::bad_input, "grown tile: its point count differs from the tile store's");
-    }
-    auto check = [&](Index v) {
-      if (v >= points.size()) {
-        throw Error(Exit::bad_input, "grown tile: a corner is not a point of its tile");
-      }
-      return v;
-    };
-    // The points the live mesh must hold besides those a seam can reach: corners of the
-    // triangles that are not final, and suspects.
-    std::vector<std::uint8_t> held(points.size(), 0);
-    for (std::size_t k = growth.final_triangles; k < growth.triangles.size(); ++k) {
-      for (Index v : growth.triangles[k]) held[check(v)] = 1;
-    }
-    for (Index v : growth.second_fans) held[check(v)] = 1;
-    std::vector<std::size_t> later;
-    double inside = 0;
-    for (std::size_t j = tile + 1; j < tiles.size(); ++j) {
-      const double far = m.reach[j].touch + m.reach[j].margin;
-      if (tiles[j].points > 0 && box_gap(tiles[tile].box, tiles[j].box) <= far) {
-        later.push_back(j);
-        inside = std::max(inside, far);
+  for (std::uint32_t g = 0; g < growth.groups; ++g) {
+    live.add_group();
+    live.sums[base + g] = d.sums[g];
+  }
+  // Final triangles go to the output now, numbered on from the vertices given so far.
+  const std::uint32_t first_number = m.released.vertices;
+  std::uint32_t next_new = 0;
+  std::size_t next_done = 0;
+  for (std::size_t k = 0; k < growth.final_triangles; ++k) {
+    const Triangle& t = growth.triangles[k];
+    for (Index l : t) {
+      if (l == next_new) {
+        m.sink.vertex(d.vertex_ids[l], &d.vertex_xyz[3 * std::size_t{l}]);
+        ++next_new;
       }
     }
-    // Deeper than this, a point is out of reach of this tile's seams, even as the far corner of a
-    // live triangle touching the band (the longest edge: the margin).
-    const double unreachable = m.reach[tile].touch + m.reach[tile].margin;
-    // Each point's release step, and whether a seam can look it up, known before the final
-    // triangles go out: a point only they use is announced done to the sink right after its
-    // last one (a sink counting defects in stride then holds few points open).
-    std::vector<std::uint32_t> release(points.size());
-    std::vector<std::uint8_t> listed(points.size());
-    for (std::size_t k = 0; k < points.size(); ++k) {
-      const double* p = &points.xyz[3 * k];
-      release[k] = m.last_step(tile, p, later, inside, true);
-      listed[k] = release[k] != tile || box_depth(tiles[tile].box, p) <= unreachable;
+    m.sink.triangle({first_number + t[0], first_number + t[1], first_number + t[2]},
+                    {&d.vertex_xyz[3 * std::size_t{t[0]}], &d.vertex_xyz[3 * std::size_t{t[1]}],
+                     &d.vertex_xyz[3 * std::size_t{t[2]}]},
+                    base + growth.group[k]);
+    for (; next_done < d.done.size() && d.done[next_done].first == k; ++next_done) {
+      m.sink.vertex_done(first_number + d.done[next_done].second);
     }
-    std::vector<std::size_t> last_final(points.size(), growth.final_triangles);
-    for (std::size_t k = 0; k < growth.final_triangles; ++k) {
-      for (Index v : growth.triangles[k]) last_final[check(v)] = k;
-    }
-    // Final triangles go to the output now; a corner's vertex number moves into its slot if it
-    // gets one.
-    std::vector<std::uint32_t> number(points.size(), kNoIndex);
-    for (std::size_t k = 0; k < growth.final_triangles; ++k) {
-      const Triangle& t = growth.triangles[k];
-      const std::uint32_t group = base + growth.group[k];
-      emit_triangle({&number[t[0]], &number[t[1]], &number[t[2]]},
-                    {&points.xyz[3 * std::size_t{t[0]}], &points.xyz[3 * std::size_t{t[1]}],
-                     &points.xyz[3 * std::size_t{t[2]}]},
-                    {points.ids[t[0]], points.ids[t[1]], points.ids[t[2]]}, live.sums[group], group,
-                    m.origin, m.sink, m.released);
-      for (Index v : t) {
-        if (last_final[v] == k && !listed[v] && !held[v]) {
-          m.sink.vertex_done(number[v]);
-          last_final[v] = growth.final_triangles;
-        }
-      }
-    }
-    slot_of_point.assign(points.size(), kNoIndex);
-    for (std::size_t k = 0; k < points.size(); ++k) {
-      if (points.ids[k] >= m.source.point_count()) {
-        throw Error(Exit::bad_input, "tile store: a point id is out of range");
-      }
-      const double* p = &points.xyz[3 * k];
-      if (!listed[k] && !held[k]) continue;  // only in final triangles, or in none
-      const std::uint32_t finish =
-          release[k] == tile ? release[k] : m.last_step(tile, p, later, inside, false);
-      slot_of_point[k] = live.add_point(points.ids[k], p, finish, release[k], listed[k] != 0);
-      live.number[slot_of_point[k]] = number[k];
-    }
+  }
+  m.released.vertices += next_new;
+  m.released.triangles += growth.final_triangles;
+  std::vector<std::uint32_t> slot_of_held(d.held.size());
+  for (std::size_t h = 0; h < d.held.size(); ++h) {
+    const PreparedTile::Data::Held& p = d.held[h];
+    slot_of_held[h] = live.add_point(p.id, p.xyz, p.finish, p.release, p.listed);
+    live.number[slot_of_held[h]] = p.number == kNoIndex ? kNoIndex : first_number + p.number;
   }
   for (std::size_t k = growth.final_triangles; k < growth.triangles.size(); ++k) {
     const Triangle& t = growth.triangles[k];
-    live.add_triangle({slot_of_point[t[0]], slot_of_point[t[1]], slot_of_point[t[2]]},
+    live.add_triangle({slot_of_held[t[0]], slot_of_held[t[1]], slot_of_held[t[2]]},
                       base + growth.group[k]);
   }
-  for (Index v : growth.second_fans) live.flags[slot_of_point[v]] |= LiveMesh::kSuspect;
+  for (Index h : growth.second_fans) live.flags[slot_of_held[h]] |= LiveMesh::kSuspect;
   MeshReport& r = m.out.report;
   r.points += growth.report.points;
   r.seeds += growth.report.seeds;
@@ -448,7 +528,7 @@ void Stitcher::add(std::size_t tile, TileGrowth growth) {
   r.triangles_removed += growth.report.triangles_removed;
   r.non_manifold_vertices_fixed += growth.report.non_manifold_vertices_fixed;
   r.spacing = std::max(r.spacing, growth.report.spacing);
-  growth = TileGrowth{};
+  prepared = PreparedTile{};
   const auto [added, dropped] = m.stitcher.stitch(tile, m.reach[tile], live);
   m.out.triangles_stitched += added;
   m.out.seam_triangles_dropped += dropped;
