@@ -5,11 +5,29 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
+#include <utility>
 
 #include "g2s/types.hpp"
 
 namespace g2s {
+
+// Triangles handed on at once whose corners are all new (no triangle before them used one): the
+// final triangles of a tile. Vertices are numbered from 0 in order of first use, groups from 0.
+struct SinkBlock {
+  std::span<const Index> ids;            // per vertex: its point's global id
+  std::span<const double> xyz;           // per vertex: x, y, z
+  std::span<const Triangle> triangles;   // by vertex number
+  std::span<const std::uint32_t> group;  // per triangle
+  // (triangle, vertex): the vertex gets no triangle after that one, in increasing triangle order.
+  std::span<const std::pair<std::uint32_t, std::uint32_t>> done;
+};
+
+// What a sink worked out ahead on a block (MeshSink::prepare), handed back with it.
+struct SinkBlockWork {
+  virtual ~SinkBlockWork() = default;
+};
 
 class MeshSink {
  public:
@@ -25,6 +43,18 @@ class MeshSink {
   // complete. A sink that counts defects in stride (StreamStats) finishes its edges then; others
   // ignore it. Vertices not announced here are complete at finish().
   virtual void vertex_done(std::uint32_t vertex) { (void)vertex; }
+  // Work on a block that need not wait for the sink's turn: called on any thread, for several
+  // blocks at once, while the sink takes other calls, so it may read only what those never
+  // change. None by default.
+  virtual std::unique_ptr<SinkBlockWork> prepare(const SinkBlock& block) const {
+    (void)block;
+    return nullptr;
+  }
+  // The block, its vertices numbered from first_vertex and its groups from first_group, with
+  // what prepare() gave for it: the same as vertex(), triangle() and vertex_done() in order,
+  // which is what the default does.
+  virtual void block(const SinkBlock& block, std::uint32_t first_vertex, std::uint32_t first_group,
+                     std::unique_ptr<SinkBlockWork> work);
   // Every triangle has been given: those of group g are to be reversed where flip[g] != 0.
   virtual void finish(std::span<const std::uint8_t> flip) = 0;
 };

@@ -39,6 +39,12 @@ class StreamStats final : public MeshSink {
   void triangle(const Triangle& corners, const std::array<const double*, 3>& xyz,
                 std::uint32_t group) override;
   void vertex_done(std::uint32_t vertex) override;
+  // A block is counted ahead where no welding is needed (positions_distinct): its triangles,
+  // the stars of the vertices it says are done, and how it joins the others, which the counter
+  // then holds open as if the block had come triangle by triangle.
+  std::unique_ptr<SinkBlockWork> prepare(const SinkBlock& block) const override;
+  void block(const SinkBlock& block, std::uint32_t first_vertex, std::uint32_t first_group,
+             std::unique_ptr<SinkBlockWork> work) override;
   void finish(std::span<const std::uint8_t> flip) override;
 
   const MeshStats& stats() const;

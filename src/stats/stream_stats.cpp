@@ -207,15 +207,314 @@ struct EdgeGroup {
   std::uint32_t out;  // how many run v -> w
 };
 
+// A triangle as seen from one of its corners: the corners after and before it, and its group.
+struct Wedge {
+  std::uint32_t next;
+  std::uint32_t prev;
+  std::uint32_t group;
+};
+
+// What judging stars adds up. Edge classes are counted at both ends of each edge (halved at the
+// end).
+struct StarCounts {
+  std::uint64_t vertices = 0;  // with a triangle
+  std::uint64_t non_manifold_vertices = 0;
+  std::uint64_t non_manifold_vertices_type1 = 0;
+  std::uint64_t non_manifold_vertices_type2 = 0;
+  std::uint64_t boundary_ends = 0;
+  std::uint64_t conflict_ends = 0;
+  std::uint64_t non_manifold_ends = 0;
+
+  StarCounts& operator+=(const StarCounts& o) {
+    vertices += o.vertices;
+    non_manifold_vertices += o.non_manifold_vertices;
+    non_manifold_vertices_type1 += o.non_manifold_vertices_type1;
+    non_manifold_vertices_type2 += o.non_manifold_vertices_type2;
+    boundary_ends += o.boundary_ends;
+    conflict_ends += o.conflict_ends;
+    non_manifold_ends += o.non_manifold_ends;
+    return *this;
+  }
+};
+
+// Judges complete stars (one vertex's triangles, as wedges): its fans and its edges. For each
+// boundary edge, boundary(w) is called with its other end; for each two-triangle edge between
+// two groups, pair(g1, g2, opposite) with g1 < g2 (whether the two run opposite ways; the
+// conflict is settled once the groups' flips are known). Scratch arrays are kept between stars.
+class StarJudge {
+ public:
+  template <class Boundary, class Pair>
+  void judge(std::span<const Wedge> s, StarCounts& c, Boundary&& boundary, Pair&& pair) {
+    if (!s.empty()) ++c.vertices;
+    if (!judge_simple_star(s, c, boundary, pair)) judge_star(s, c, boundary, pair);
+  }
+
+ private:
+  // The common star, judged in one pass: no two of its triangles share their next corner or
+  // their previous one. Then each edge holds one or two of them, two running opposite ways, and
+  // "triangle j follows triangle i" (i's next corner is j's previous one) links them into
+  // chains (open fans, starting at a triangle that follows none) and cycles (closed fans). The
+  // counts are those judge_star gives; false (nothing counted) for any other star.
+  static constexpr std::size_t kSimpleStar = 16;
+  template <class Boundary, class Pair>
+  static bool judge_simple_star(std::span<const Wedge> s, StarCounts& c, Boundary& boundary,
+                                Pair& pair) {
+    const std::size_t k = s.size();
+    if (k > kSimpleStar) return false;
+    std::array<std::uint32_t, kSimpleStar> follower;  // kNoIndex: none (a boundary edge)
+    std::array<bool, kSimpleStar> preceded;
+    std::fill_n(follower.begin(), k, kNoIndex);
+    std::fill_n(preceded.begin(), k, false);
+    for (std::uint32_t i = 0; i < k; ++i) {
+      for (std::uint32_t j = i + 1; j < k; ++j) {
+        if (s[i].next == s[j].next || s[i].prev == s[j].prev) return false;
+        if (s[i].next == s[j].prev) {
+          follower[i] = j;
+          preceded[j] = true;
+        }
+        if (s[j].next == s[i].prev) {
+          follower[j] = i;
+          preceded[i] = true;
+        }
+      }
+    }
+    std::size_t links = 0, starts = 0;
+    for (std::size_t i = 0; i < k; ++i) {
+      if (follower[i] == kNoIndex) {
+        boundary(s[i].next);
+      } else {
+        ++links;
+        const std::uint32_t g1 = s[i].group, g2 = s[follower[i]].group;
+        if (g1 != g2) pair(std::min(g1, g2), std::max(g1, g2), true);
+      }
+      if (!preceded[i]) {
+        ++starts;
+        boundary(s[i].prev);
+      }
+    }
+    c.boundary_ends += 2 * (k - links);
+    // The triangles left over after walking the chains from their starts form the cycles.
+    std::array<bool, kSimpleStar> seen{};
+    for (std::size_t i = 0; i < k; ++i) {
+      if (preceded[i]) continue;
+      for (std::uint32_t t = static_cast<std::uint32_t>(i); t != kNoIndex; t = follower[t]) {
+        seen[t] = true;
+      }
+    }
+    std::size_t cycles = 0;
+    for (std::size_t i = 0; i < k; ++i) {
+      if (seen[i]) continue;
+      ++cycles;
+      for (std::uint32_t t = static_cast<std::uint32_t>(i); !seen[t]; t = follower[t]) {
+        seen[t] = true;
+      }
+    }
+    const std::size_t fans = starts + cycles;
+    if (fans > 1) {
+      ++c.non_manifold_vertices;
+      ++(cycles > 0 ? c.non_manifold_vertices_type1 : c.non_manifold_vertices_type2);
+    }
+    return true;
+  }
+
+  // Any star: its edges grouped by their other end, fans as unions of triangles across
+  // two-triangle edges.
+  template <class Boundary, class Pair>
+  void judge_star(std::span<const Wedge> s, StarCounts& c, Boundary& boundary, Pair& pair) {
+    groups_.clear();
+    group_next_.clear();
+    group_prev_.clear();
+    auto touch = [&](std::uint32_t w, std::uint32_t i, std::uint32_t outgoing) {
+      std::uint32_t g = 0;
+      while (g < groups_.size() && groups_[g].w != w) ++g;
+      if (g == groups_.size()) groups_.push_back({w, 0, i, 0, 0});
+      EdgeGroup& e = groups_[g];
+      if (e.count == 1) e.second = i;
+      ++e.count;
+      e.out += outgoing;
+      return g;
+    };
+    for (std::uint32_t i = 0; i < s.size(); ++i) {
+      group_next_.push_back(touch(s[i].next, i, 1));
+      group_prev_.push_back(touch(s[i].prev, i, 0));
+    }
+    const std::size_t k = s.size();
+    fan_.resize(k);
+    for (std::uint32_t i = 0; i < k; ++i) fan_[i] = i;
+    for (const EdgeGroup& e : groups_) {
+      if (e.count == 1) {
+        ++c.boundary_ends;
+        boundary(e.w);
+      } else if (e.count == 2) {
+        const std::uint32_t a = find_root(fan_, e.first), b = find_root(fan_, e.second);
+        if (a != b) fan_[std::max(a, b)] = std::min(a, b);
+        const std::uint32_t g1 = s[e.first].group, g2 = s[e.second].group;
+        const bool same_way = e.out != 1;
+        if (g1 == g2) {
+          c.conflict_ends += same_way ? 1 : 0;
+        } else {
+          pair(std::min(g1, g2), std::max(g1, g2), !same_way);
+        }
+      } else {
+        ++c.non_manifold_ends;
+      }
+    }
+    fan_open_.assign(k, 0);
+    std::size_t fans = 0;
+    for (std::uint32_t i = 0; i < k; ++i) {
+      const std::uint32_t root = find_root(fan_, i);
+      if (root == i) ++fans;
+      if (groups_[group_next_[i]].count != 2 || groups_[group_prev_[i]].count != 2) {
+        fan_open_[root] = 1;
+      }
+    }
+    if (fans > 1) {
+      ++c.non_manifold_vertices;
+      bool any_closed = false;
+      for (std::uint32_t i = 0; i < k; ++i)
+        any_closed = any_closed || (fan_[i] == i && !fan_open_[i]);
+      ++(any_closed ? c.non_manifold_vertices_type1 : c.non_manifold_vertices_type2);
+    }
+  }
+
+  std::vector<EdgeGroup> groups_;
+  std::vector<std::uint32_t> group_next_, group_prev_, fan_;
+  std::vector<std::uint8_t> fan_open_;
+};
+
+// Two equal corners, or a cross product of exactly zero (compute_stats' test, on the positions as
+// written).
+bool degenerate(const std::array<std::uint32_t, 3>& o, const double (&p)[3][3]) {
+  if (o[0] == o[1] || o[1] == o[2] || o[0] == o[2]) return true;
+  const double* a = p[0];
+  const double* b = p[1];
+  const double* c = p[2];
+  const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+  return u[1] * v[2] - u[2] * v[1] == 0.0 && u[2] * v[0] - u[0] * v[2] == 0.0 &&
+         u[0] * v[1] - u[1] * v[0] == 0.0;
+}
+
+// Whether a star already holds a triangle on the vertex set {w1, w2} (either way round).
+bool holds_triangle(std::span<const Wedge> star, std::uint32_t w1, std::uint32_t w2) {
+  for (const Wedge& w : star) {
+    if ((w.next == w1 && w.prev == w2) || (w.next == w2 && w.prev == w1)) return true;
+  }
+  return false;
+}
+
+// A position as the file stores it: rounded to float for STL.
+void stored_position(const double* given, bool rounded, double* p) {
+  for (int k = 0; k < 3; ++k) {
+    p[k] = rounded ? static_cast<double>(static_cast<float>(given[k])) : given[k];
+  }
+}
+
+// A block counted ahead (StreamStats::prepare), in the block's own numbers: every vertex the
+// block says is done is judged; the others (held: later triangles will reach them) are handed to
+// the counter with their wedges so far, and how the block joins them.
+struct BlockCount final : SinkBlockWork {
+  std::uint64_t triangles = 0;
+  std::uint64_t degenerate = 0;
+  std::uint64_t duplicates = 0;
+  StarCounts counts;
+  // Two-triangle edges between groups, (lower << 32 | higher) with the block's groups, and how
+  // many run the same way and how many opposite ways.
+  std::vector<std::pair<std::uint64_t, std::array<std::uint64_t, 2>>> pairs;
+  std::vector<std::uint32_t> held;        // vertex numbers, increasing
+  std::vector<std::uint32_t> held_start;  // per held vertex: its first wedge in held_wedges
+  std::vector<Wedge> held_wedges;
+  // The unions the block made in the component and boundary forests, less those the counter
+  // makes again when it joins the held vertices each set holds (links: pairs of places in held).
+  std::uint64_t component_merges = 0;
+  std::uint64_t boundary_merges = 0;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> component_links;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> boundary_links;
+  std::unique_ptr<SinkBlockWork> next;  // the next sink's work on the block
+};
+
+// Pairs each held vertex (held: vertex numbers) with the first held vertex of its set in
+// `forest` (one node per vertex of the block); returns the forest's merges less the pairs, which
+// the counter makes again when it joins the held vertices.
+std::uint64_t held_links(OpenUnionFind& forest, std::span<const std::uint32_t> held,
+                         std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) {
+  std::vector<std::uint32_t> first(forest.parent.size(), kNoIndex);  // per root: its first held
+  for (std::uint32_t h = 0; h < held.size(); ++h) {
+    std::uint32_t& f = first[find_root(forest.parent, held[h])];
+    if (f == kNoIndex) {
+      f = h;
+    } else {
+      out.emplace_back(f, h);
+    }
+  }
+  return forest.merges - out.size();
+}
+
+std::unique_ptr<BlockCount> count_block(const SinkBlock& b, bool rounded) {
+  auto out = std::make_unique<BlockCount>();
+  const std::size_t n = b.ids.size();
+  const std::size_t t_count = b.triangles.size();
+  std::vector<std::uint8_t> done(n, 0);
+  for (const auto& [t, v] : b.done) done[v] = 1;
+  // Each vertex's star, in triangle order (the order the counter adds wedges).
+  std::vector<std::uint32_t> start(n + 1, 0);
+  for (const Triangle& t : b.triangles) {
+    for (Index v : t) ++start[v + 1];
+  }
+  for (std::size_t v = 0; v < n; ++v) start[v + 1] += start[v];
+  std::vector<std::uint32_t> filled(start.begin(), start.end() - 1);
+  std::vector<Wedge> wedges(start[n]);
+  OpenUnionFind components, borders;  // over the block's vertices
+  for (std::size_t v = 0; v < n; ++v) {
+    components.add();
+    borders.add();
+  }
+  out->triangles = t_count;
+  for (std::size_t k = 0; k < t_count; ++k) {
+    const Triangle& t = b.triangles[k];
+    double p[3][3];
+    for (int c = 0; c < 3; ++c) stored_position(&b.xyz[3 * std::size_t{t[c]}], rounded, p[c]);
+    if (degenerate({t[0], t[1], t[2]}, p)) {
+      ++out->degenerate;
+      continue;
+    }
+    if (holds_triangle(std::span(&wedges[start[t[0]]], filled[t[0]] - start[t[0]]), t[1], t[2])) {
+      ++out->duplicates;
+      continue;
+    }
+    for (int c = 0; c < 3; ++c) {
+      wedges[filled[t[c]]++] = {t[(c + 1) % 3], t[(c + 2) % 3], b.group[k]};
+    }
+    components.unite(t[0], t[1]);
+    components.unite(t[0], t[2]);
+  }
+  std::unordered_map<std::uint64_t, std::array<std::uint64_t, 2>> pairs;
+  StarJudge judge;
+  for (std::uint32_t v = 0; v < n; ++v) {
+    const std::span<const Wedge> star(&wedges[start[v]], filled[v] - start[v]);
+    if (!done[v]) {
+      out->held.push_back(v);
+      out->held_start.push_back(static_cast<std::uint32_t>(out->held_wedges.size()));
+      out->held_wedges.insert(out->held_wedges.end(), star.begin(), star.end());
+      continue;
+    }
+    judge.judge(
+        star, out->counts, [&](std::uint32_t w) { borders.unite(v, w); },
+        [&](std::uint32_t g1, std::uint32_t g2, bool opposite) {
+          ++pairs[std::uint64_t{g1} << 32 | g2][opposite ? 1 : 0];
+        });
+  }
+  out->held_start.push_back(static_cast<std::uint32_t>(out->held_wedges.size()));
+  out->pairs.assign(pairs.begin(), pairs.end());
+  std::sort(out->pairs.begin(), out->pairs.end());
+  out->component_merges = held_links(components, out->held, out->component_links);
+  out->boundary_merges = held_links(borders, out->held, out->boundary_links);
+  return out;
+}
+
 }  // namespace
 
 struct StreamStats::Impl {
-  // A triangle as seen from one of its corners: the corners after and before it, and its group.
-  struct Wedge {
-    std::uint32_t next;
-    std::uint32_t prev;
-    std::uint32_t group;
-  };
   static constexpr std::uint32_t kInlineWedges = 9;  // most stars fit (G2S: about 6)
   // An open vertex: welded by position; `rep` is the number of its first vertex, the name its
   // triangles use. Two cache lines (the header and the first four wedges in the first): its
@@ -268,19 +567,13 @@ struct StreamStats::Impl {
   OpenUnionFind components;
   OpenUnionFind borders;
   std::uint64_t boundary_merges = 0;
-  // Edge classes counted at both ends of each edge (halved in finish()).
-  std::uint64_t boundary_ends = 0;
-  std::uint64_t conflict_ends = 0;
-  std::uint64_t non_manifold_ends = 0;
+  StarCounts counts;
   // Two-triangle edges between different groups, per (lower group << 32 | higher): how many run
   // the same way and how many opposite ways before the flips.
   std::unordered_map<std::uint64_t, std::array<std::uint64_t, 2>> group_pairs;
 
-  // Per-star scratch.
-  std::vector<Wedge> star;
-  std::vector<EdgeGroup> groups;
-  std::vector<std::uint32_t> group_next, group_prev, fan;
-  std::vector<std::uint8_t> fan_open;
+  std::vector<Wedge> star;  // a large star gathered
+  StarJudge star_judge;
 
   bool same_position(const double* a, const double* b) const {
     return key_bits(a[0]) == key_bits(b[0]) && key_bits(a[1]) == key_bits(b[1]) &&
@@ -336,45 +629,95 @@ struct StreamStats::Impl {
     }
   }
 
-  // A position as the file stores it.
-  void stored_position(const double* given, double* p) const {
-    for (int k = 0; k < 3; ++k) {
-      p[k] = float_positions ? static_cast<double>(static_cast<float>(given[k])) : given[k];
+  // A new open vertex's record: vertex `number`, at position p as stored, no references yet.
+  std::uint32_t new_open(std::uint32_t number, const double* p) {
+    std::uint32_t o = 0;
+    if (free_open.empty()) {
+      o = slots++;
+      if ((o >> kChunkBits) == chunks.size()) {
+        chunks.push_back(std::make_unique_for_overwrite<Open[]>(std::size_t{1} << kChunkBits));
+      }
+      node.emplace_back();
+      position.emplace_back();
+    } else {
+      o = free_open.back();
+      free_open.pop_back();
     }
+    Open& v = open(o);
+    std::copy_n(p, 3, position[o].begin());
+    v.rep = number;
+    node[o].refs = 0;
+    v.wedges = 0;
+    v.overflow = kNoIndex;
+    node[o].component = components.add();
+    node[o].border = borders.add();
+    ++open_count;
+    return o;
   }
 
   void add_vertex(const double* given) {
     const std::uint32_t number = numbered++;
     double p[3];
-    stored_position(given, p);
+    stored_position(given, float_positions, p);
     const std::uint32_t key = welding ? weld_key(p) : 0;
     std::uint32_t o = welding ? welder_find(p, key) : kNoIndex;
     if (o == kNoIndex) {
-      if (free_open.empty()) {
-        o = slots++;
-        if ((o >> kChunkBits) == chunks.size()) {
-          chunks.push_back(std::make_unique_for_overwrite<Open[]>(std::size_t{1} << kChunkBits));
-        }
-        node.emplace_back();
-        position.emplace_back();
-      } else {
-        o = free_open.back();
-        free_open.pop_back();
-      }
-      Open& v = open(o);
-      std::copy_n(p, 3, position[o].begin());
-      v.rep = number;
-      node[o].refs = 0;
-      v.wedges = 0;
-      v.overflow = kNoIndex;
-      node[o].component = components.add();
-      node[o].border = borders.add();
-      ++open_count;
+      o = new_open(number, p);
       if (welding) welder_insert(o, key);
     }
     ++node[o].refs;
     if (components.parent.size() > 2 * open_count + 4096) compact();
     open_of.insert(number, o);
+  }
+
+  // A vertex of a block held open (not welded: blocks are counted ahead only without welding).
+  std::uint32_t add_held(std::uint32_t number, const double* given) {
+    double p[3];
+    stored_position(given, float_positions, p);
+    const std::uint32_t o = new_open(number, p);
+    node[o].refs = 1;
+    open_of.insert(number, o);
+    return o;
+  }
+
+  // A block counted ahead: its counts, and its held vertices opened with their wedges and the
+  // joins the block made between them.
+  void add_block(const SinkBlock& b, std::uint32_t first_vertex, std::uint32_t first_group,
+                 const BlockCount& block) {
+    if (first_vertex != numbered) complete = false;
+    numbered += static_cast<std::uint32_t>(b.ids.size());
+    stats.triangles += block.triangles;
+    stats.degenerate_triangles += block.degenerate;
+    stats.duplicate_triangles += block.duplicates;
+    counts += block.counts;
+    for (const auto& [pair, ways] : block.pairs) {
+      const std::uint64_t g1 = (pair >> 32) + first_group, g2 = (pair & 0xFFFFFFFFu) + first_group;
+      std::array<std::uint64_t, 2>& total = group_pairs[g1 << 32 | g2];
+      total[0] += ways[0];
+      total[1] += ways[1];
+    }
+    std::vector<std::uint32_t> opened(block.held.size());
+    for (std::size_t h = 0; h < block.held.size(); ++h) {
+      const std::uint32_t v = block.held[h];
+      opened[h] = add_held(first_vertex + v, &b.xyz[3 * std::size_t{v}]);
+      Open& record = open(opened[h]);
+      for (std::uint32_t w = block.held_start[h]; w < block.held_start[h + 1]; ++w) {
+        const Wedge& wedge = block.held_wedges[w];
+        add_wedge(record, {first_vertex + wedge.next, first_vertex + wedge.prev,
+                           first_group + wedge.group});
+      }
+    }
+    components.merges += block.component_merges;
+    for (const auto& [a, c] : block.component_links) {
+      components.unite(node[opened[a]].component, node[opened[c]].component);
+    }
+    boundary_merges += block.boundary_merges;
+    for (const auto& [a, c] : block.boundary_links) {
+      const std::uint64_t before = borders.merges;
+      borders.unite(node[opened[a]].border, node[opened[c]].border);
+      boundary_merges += borders.merges - before;
+    }
+    if (components.parent.size() > 2 * open_count + 4096) compact();
   }
 
   // Rebuilds both forests over the roots the open vertices reach (after noting the peak: the
@@ -389,21 +732,6 @@ struct StreamStats::Impl {
     }
     components.compact(component_nodes);
     borders.compact(border_nodes);
-  }
-
-  // Two equal welded corners, or a cross product of exactly zero (compute_stats' test, on the
-  // positions as written).
-  // The corners' positions are the triangle's own, rounded as stored (a welded corner has its
-  // twin's position).
-  bool degenerate(const std::array<std::uint32_t, 3>& o, const double (&p)[3][3]) const {
-    if (o[0] == o[1] || o[1] == o[2] || o[0] == o[2]) return true;
-    const double* a = p[0];
-    const double* b = p[1];
-    const double* c = p[2];
-    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    return u[1] * v[2] - u[2] * v[1] == 0.0 && u[2] * v[0] - u[0] * v[2] == 0.0 &&
-           u[0] * v[1] - u[1] * v[0] == 0.0;
   }
 
   void for_each_wedge(const Open& v, const auto& visit) const {
@@ -454,7 +782,7 @@ struct StreamStats::Impl {
       }
     }
     double p[3][3];
-    for (int k = 0; k < 3; ++k) stored_position(xyz[k], p[k]);
+    for (int k = 0; k < 3; ++k) stored_position(xyz[k], float_positions, p[k]);
     if (degenerate(o, p)) {
       ++stats.degenerate_triangles;
       return;
@@ -496,8 +824,11 @@ struct StreamStats::Impl {
       overflow[vertex.overflow].clear();
       free_overflow.push_back(vertex.overflow);
     }
-    if (!wedges.empty()) ++stats.vertices;
-    if (!judge_simple_star(o, wedges)) judge_star(o, wedges);
+    star_judge.judge(
+        wedges, counts, [&](std::uint32_t w) { join_boundary(o, w); },
+        [&](std::uint32_t g1, std::uint32_t g2, bool opposite) {
+          ++group_pairs[std::uint64_t{g1} << 32 | g2][opposite ? 1 : 0];
+        });
     open_of.erase(vertex.rep);
     if (welding) welder_erase(o);
     node[o].refs = 0;
@@ -515,131 +846,6 @@ struct StreamStats::Impl {
     boundary_merges += borders.merges - before;
   }
 
-  // The common star, judged in one pass: no two of its triangles share their next corner or
-  // their previous one. Then each edge holds one or two of them, two running opposite ways, and
-  // "triangle j follows triangle i" (i's next corner is j's previous one) links them into
-  // chains (open fans, starting at a triangle that follows none) and cycles (closed fans). The
-  // counts are those judge_star gives; false (nothing counted) for any other star.
-  static constexpr std::size_t kSimpleStar = 16;
-  bool judge_simple_star(std::uint32_t o, std::span<const Wedge> s) {
-    const std::size_t k = s.size();
-    if (k > kSimpleStar) return false;
-    std::array<std::uint32_t, kSimpleStar> follower;  // kNoIndex: none (a boundary edge)
-    std::array<bool, kSimpleStar> preceded;
-    std::fill_n(follower.begin(), k, kNoIndex);
-    std::fill_n(preceded.begin(), k, false);
-    for (std::uint32_t i = 0; i < k; ++i) {
-      for (std::uint32_t j = i + 1; j < k; ++j) {
-        if (s[i].next == s[j].next || s[i].prev == s[j].prev) return false;
-        if (s[i].next == s[j].prev) {
-          follower[i] = j;
-          preceded[j] = true;
-        }
-        if (s[j].next == s[i].prev) {
-          follower[j] = i;
-          preceded[i] = true;
-        }
-      }
-    }
-    std::size_t links = 0, starts = 0;
-    for (std::size_t i = 0; i < k; ++i) {
-      if (follower[i] == kNoIndex) {
-        join_boundary(o, s[i].next);
-      } else {
-        ++links;
-        const std::uint32_t g1 = s[i].group, g2 = s[follower[i]].group;
-        if (g1 != g2) {
-          ++group_pairs[std::uint64_t{std::min(g1, g2)} << 32 | std::max(g1, g2)][1];
-        }
-      }
-      if (!preceded[i]) {
-        ++starts;
-        join_boundary(o, s[i].prev);
-      }
-    }
-    boundary_ends += 2 * (k - links);
-    // The triangles left over after walking the chains from their starts form the cycles.
-    std::array<bool, kSimpleStar> seen{};
-    for (std::size_t i = 0; i < k; ++i) {
-      if (preceded[i]) continue;
-      for (std::uint32_t t = static_cast<std::uint32_t>(i); t != kNoIndex; t = follower[t]) {
-        seen[t] = true;
-      }
-    }
-    std::size_t cycles = 0;
-    for (std::size_t i = 0; i < k; ++i) {
-      if (seen[i]) continue;
-      ++cycles;
-      for (std::uint32_t t = static_cast<std::uint32_t>(i); !seen[t]; t = follower[t]) {
-        seen[t] = true;
-      }
-    }
-    const std::size_t fans = starts + cycles;
-    if (fans > 1) {
-      ++stats.non_manifold_vertices;
-      ++(cycles > 0 ? stats.non_manifold_vertices_type1 : stats.non_manifold_vertices_type2);
-    }
-    return true;
-  }
-
-  // Any star: its edges grouped by their other end, fans as unions of triangles across
-  // two-triangle edges.
-  void judge_star(std::uint32_t o, std::span<const Wedge> s) {
-    groups.clear();
-    group_next.clear();
-    group_prev.clear();
-    auto touch = [&](std::uint32_t w, std::uint32_t i, std::uint32_t outgoing) {
-      std::uint32_t g = 0;
-      while (g < groups.size() && groups[g].w != w) ++g;
-      if (g == groups.size()) groups.push_back({w, 0, i, 0, 0});
-      EdgeGroup& e = groups[g];
-      if (e.count == 1) e.second = i;
-      ++e.count;
-      e.out += outgoing;
-      return g;
-    };
-    for (std::uint32_t i = 0; i < s.size(); ++i) {
-      group_next.push_back(touch(s[i].next, i, 1));
-      group_prev.push_back(touch(s[i].prev, i, 0));
-    }
-    const std::size_t k = s.size();
-    fan.resize(k);
-    for (std::uint32_t i = 0; i < k; ++i) fan[i] = i;
-    for (const EdgeGroup& e : groups) {
-      if (e.count == 1) {
-        ++boundary_ends;
-        join_boundary(o, e.w);
-      } else if (e.count == 2) {
-        const std::uint32_t a = find_root(fan, e.first), b = find_root(fan, e.second);
-        if (a != b) fan[std::max(a, b)] = std::min(a, b);
-        const std::uint32_t g1 = s[e.first].group, g2 = s[e.second].group;
-        const bool same_way = e.out != 1;
-        if (g1 == g2) {
-          conflict_ends += same_way ? 1 : 0;
-        } else {
-          const std::uint64_t pair = std::uint64_t{std::min(g1, g2)} << 32 | std::max(g1, g2);
-          ++group_pairs[pair][same_way ? 0 : 1];
-        }
-      } else {
-        ++non_manifold_ends;
-      }
-    }
-    fan_open.assign(k, 0);
-    std::size_t fans = 0;
-    for (std::uint32_t i = 0; i < k; ++i) {
-      const std::uint32_t root = find_root(fan, i);
-      if (root == i) ++fans;
-      if (groups[group_next[i]].count != 2 || groups[group_prev[i]].count != 2) fan_open[root] = 1;
-    }
-    if (fans > 1) {
-      ++stats.non_manifold_vertices;
-      bool any_closed = false;
-      for (std::uint32_t i = 0; i < k; ++i)
-        any_closed = any_closed || (fan[i] == i && !fan_open[i]);
-      ++(any_closed ? stats.non_manifold_vertices_type1 : stats.non_manifold_vertices_type2);
-    }
-  }
-
   void finish(std::span<const std::uint8_t> flip) {
     for (std::uint32_t o = 0; o < slots; ++o) {
       if (node[o].refs > 0) {
@@ -650,11 +856,15 @@ struct StreamStats::Impl {
     for (const auto& [pair, ways] : group_pairs) {
       const auto g1 = static_cast<std::uint32_t>(pair >> 32), g2 = static_cast<std::uint32_t>(pair);
       const bool one_flipped = (g1 < flip.size() && flip[g1]) != (g2 < flip.size() && flip[g2]);
-      conflict_ends += one_flipped ? ways[1] : ways[0];
+      counts.conflict_ends += one_flipped ? ways[1] : ways[0];
     }
-    stats.boundary_edges = boundary_ends / 2;
-    stats.orientation_conflicts = conflict_ends / 2;
-    stats.non_manifold_edges = non_manifold_ends / 2;
+    stats.vertices = counts.vertices;
+    stats.non_manifold_vertices = counts.non_manifold_vertices;
+    stats.non_manifold_vertices_type1 = counts.non_manifold_vertices_type1;
+    stats.non_manifold_vertices_type2 = counts.non_manifold_vertices_type2;
+    stats.boundary_edges = counts.boundary_ends / 2;
+    stats.orientation_conflicts = counts.conflict_ends / 2;
+    stats.non_manifold_edges = counts.non_manifold_ends / 2;
     stats.holes = stats.boundary_edges - boundary_merges;
     stats.components = stats.vertices - components.merges;
   }
@@ -691,6 +901,26 @@ void StreamStats::triangle(const Triangle& corners, const std::array<const doubl
 void StreamStats::vertex_done(std::uint32_t vertex) {
   impl_->done(vertex);
   impl_->next.vertex_done(vertex);
+}
+
+std::unique_ptr<SinkBlockWork> StreamStats::prepare(const SinkBlock& block) const {
+  // Welding needs the positions of every open vertex: such blocks go triangle by triangle.
+  if (impl_->welding) return nullptr;
+  std::unique_ptr<BlockCount> work = count_block(block, impl_->float_positions);
+  work->next = impl_->next.prepare(block);
+  return work;
+}
+
+void StreamStats::block(const SinkBlock& block, std::uint32_t first_vertex,
+                        std::uint32_t first_group, std::unique_ptr<SinkBlockWork> work) {
+  if (!work) {
+    MeshSink::block(block, first_vertex, first_group, nullptr);
+    return;
+  }
+  // Only prepare() makes this sink's work.
+  auto& counted = static_cast<BlockCount&>(*work);
+  impl_->add_block(block, first_vertex, first_group, counted);
+  impl_->next.block(block, first_vertex, first_group, std::move(counted.next));
 }
 
 void StreamStats::finish(std::span<const std::uint8_t> flip) {

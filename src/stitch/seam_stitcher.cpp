@@ -366,7 +366,14 @@ struct PreparedTile::Data {
   std::vector<Index> vertex_ids;
   std::vector<double> vertex_xyz;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> done;
-  std::vector<GroupSums> sums;  // per group of the tile, over its final triangles
+  std::vector<GroupSums> sums;               // per group of the tile, over its final triangles
+  std::unique_ptr<SinkBlockWork> sink_work;  // the sink's own work on the final triangles
+
+  SinkBlock final_block() const {
+    return {vertex_ids, vertex_xyz,
+            std::span<const Triangle>(growth.triangles.data(), growth.final_triangles),
+            std::span<const std::uint32_t>(growth.group.data(), growth.final_triangles), done};
+  }
 };
 
 PreparedTile::PreparedTile() = default;
@@ -467,6 +474,7 @@ PreparedTile Stitcher::prepare(std::size_t tile, TileGrowth growth) const {
   }
   for (Index& v : growth.second_fans) v = held_at[v];
   d.growth = std::move(growth);
+  d.sink_work = m.sink.prepare(d.final_block());
   return prepared;
 }
 
@@ -486,25 +494,8 @@ void Stitcher::add(std::size_t tile, PreparedTile prepared) {
   }
   // Final triangles go to the output now, numbered on from the vertices given so far.
   const std::uint32_t first_number = m.released.vertices;
-  std::uint32_t next_new = 0;
-  std::size_t next_done = 0;
-  for (std::size_t k = 0; k < growth.final_triangles; ++k) {
-    const Triangle& t = growth.triangles[k];
-    for (Index l : t) {
-      if (l == next_new) {
-        m.sink.vertex(d.vertex_ids[l], &d.vertex_xyz[3 * std::size_t{l}]);
-        ++next_new;
-      }
-    }
-    m.sink.triangle({first_number + t[0], first_number + t[1], first_number + t[2]},
-                    {&d.vertex_xyz[3 * std::size_t{t[0]}], &d.vertex_xyz[3 * std::size_t{t[1]}],
-                     &d.vertex_xyz[3 * std::size_t{t[2]}]},
-                    base + growth.group[k]);
-    for (; next_done < d.done.size() && d.done[next_done].first == k; ++next_done) {
-      m.sink.vertex_done(first_number + d.done[next_done].second);
-    }
-  }
-  m.released.vertices += next_new;
+  m.sink.block(d.final_block(), first_number, base, std::move(prepared.data_->sink_work));
+  m.released.vertices += static_cast<std::uint32_t>(d.vertex_ids.size());
   m.released.triangles += growth.final_triangles;
   std::vector<std::uint32_t> slot_of_held(d.held.size());
   for (std::size_t h = 0; h < d.held.size(); ++h) {

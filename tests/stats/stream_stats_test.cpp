@@ -14,6 +14,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -37,6 +38,23 @@ class NullSink final : public g2s::MeshSink {
   void triangle(const Triangle&, const std::array<const double*, 3>&, std::uint32_t) override {}
   void finish(std::span<const std::uint8_t>) override {}
 };
+
+// Hands triangle t of `mesh` to the counter one call at a time, numbering its new corners next.
+void stream_triangle(g2s::StreamStats& counter, const IndexedMesh& mesh, std::size_t t,
+                     std::uint32_t group, std::vector<std::uint32_t>& number, std::uint32_t& next) {
+  Triangle numbers{};
+  std::array<const double*, 3> xyz{};
+  for (int k = 0; k < 3; ++k) {
+    const g2s::Index v = mesh.triangles[t][k];
+    xyz[k] = &mesh.xyz[3 * std::size_t{v}];
+    if (number[v] == g2s::kNoIndex) {
+      number[v] = next++;
+      counter.vertex(v, xyz[k]);
+    }
+    numbers[k] = number[v];
+  }
+  counter.triangle(numbers, xyz, group);
+}
 
 // Streams `mesh` (triangles in `group`) through StreamStats as the pipeline does: each vertex
 // numbered before its first triangle, announced done after its last one when `early` (else
@@ -71,18 +89,7 @@ MeshStats streamed(const IndexedMesh& mesh, const std::vector<std::uint32_t>& gr
   std::vector<std::uint32_t> number(mesh.vertex_count(), g2s::kNoIndex);
   std::uint32_t next = 0;
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-    Triangle numbers{};
-    std::array<const double*, 3> xyz{};
-    for (int k = 0; k < 3; ++k) {
-      const g2s::Index v = mesh.triangles[t][k];
-      xyz[k] = &mesh.xyz[3 * std::size_t{v}];
-      if (number[v] == g2s::kNoIndex) {
-        number[v] = next++;
-        counter.vertex(v, xyz[k]);
-      }
-      numbers[k] = number[v];
-    }
-    counter.triangle(numbers, xyz, group[t]);
+    stream_triangle(counter, mesh, t, group[t], number, next);
     if (!early) continue;
     for (g2s::Index v : done_after[t]) counter.vertex_done(number[v]);
   }
@@ -112,6 +119,43 @@ void add_torus_grid(IndexedMesh& mesh, std::uint32_t rows, std::uint32_t columns
       for (double x : p) mesh.xyz.push_back(store(x));
     }
   }
+}
+
+// A torus grid of float coordinates with defects drawn from `seed`: holes (2%), reversed
+// triangles (2%), and duplicates (1%), each followed by a fin on its first edge reaching 3 rows
+// on. One orientation group per stripe of stripe_rows rows; a fin is in the next stripe's.
+struct DefectiveTorus {
+  IndexedMesh mesh;
+  std::vector<std::uint32_t> group;
+};
+DefectiveTorus defective_torus(std::uint32_t rows, std::uint32_t columns, std::uint32_t stripe_rows,
+                               unsigned seed) {
+  DefectiveTorus torus;
+  IndexedMesh& mesh = torus.mesh;
+  add_torus_grid(mesh, rows, columns,
+                 [](double x) { return static_cast<double>(static_cast<float>(x)); });
+  auto at = [&](std::uint32_t r, std::uint32_t c) { return (r % rows) * columns + c % columns; };
+  std::mt19937 random(seed);
+  for (std::uint32_t r = 0; r < rows; ++r) {
+    for (std::uint32_t c = 0; c < columns; ++c) {
+      const Triangle a{at(r, c), at(r, c + 1), at(r + 1, c + 1)};
+      const Triangle b{at(r, c), at(r + 1, c + 1), at(r + 1, c)};
+      for (Triangle t : {a, b}) {
+        const auto draw = static_cast<std::uint32_t>(random() % 100);
+        if (draw < 2) continue;               // a hole
+        if (draw < 4) std::swap(t[1], t[2]);  // reversed
+        mesh.triangles.push_back(t);
+        torus.group.push_back(r / stripe_rows);
+        if (draw == 4) {  // a duplicate, then a fin on its first edge
+          mesh.triangles.push_back({t[1], t[2], t[0]});
+          mesh.triangles.push_back({t[0], t[1], at(r + 3, c + 7)});
+          torus.group.push_back(r / stripe_rows);
+          torus.group.push_back(r / stripe_rows + 1);
+        }
+      }
+    }
+  }
+  return torus;
 }
 
 // a: counted in stride, which leaves crossings to g2s stats (and says so); b: compute_stats.
@@ -243,32 +287,8 @@ TEST(StreamStats, LargeSurfaceWithDefectsAsComputeStatsCountsIt) {
 // distinct input points), the counts are the same, on a torus of float coordinates with holes,
 // reversed triangles, duplicates and fins.
 TEST(StreamStats, DistinctPositionsNeedNoWelding) {
-  const std::uint32_t rows = 120, columns = 90;
-  IndexedMesh mesh;
-  add_torus_grid(mesh, rows, columns,
-                 [](double x) { return static_cast<double>(static_cast<float>(x)); });
-  auto at = [&](std::uint32_t r, std::uint32_t c) { return (r % rows) * columns + c % columns; };
-  std::vector<std::uint32_t> group;
-  std::mt19937 random(5);
-  for (std::uint32_t r = 0; r < rows; ++r) {
-    for (std::uint32_t c = 0; c < columns; ++c) {
-      const Triangle a{at(r, c), at(r, c + 1), at(r + 1, c + 1)};
-      const Triangle b{at(r, c), at(r + 1, c + 1), at(r + 1, c)};
-      for (Triangle t : {a, b}) {
-        const auto draw = static_cast<std::uint32_t>(random() % 100);
-        if (draw < 2) continue;               // a hole
-        if (draw < 4) std::swap(t[1], t[2]);  // reversed
-        mesh.triangles.push_back(t);
-        group.push_back(r / 30);
-        if (draw == 4) {  // a duplicate, then a fin on its first edge
-          mesh.triangles.push_back({t[1], t[2], t[0]});
-          mesh.triangles.push_back({t[0], t[1], at(r + 3, c + 7)});
-          group.push_back(r / 30);
-          group.push_back(r / 30 + 1);
-        }
-      }
-    }
-  }
+  const std::uint32_t rows = 120;
+  const auto [mesh, group] = defective_torus(rows, 90, 30, 5);
   std::vector<std::uint8_t> flip(rows / 30 + 2);
   for (std::size_t g = 0; g < flip.size(); ++g) flip[g] = g % 2;
   const MeshStats expected = g2s::compute_stats(as_written(mesh, group, flip));
@@ -284,6 +304,109 @@ TEST(StreamStats, DistinctPositionsNeedNoWelding) {
                       (early ? ", done early" : ", done at the end"));
       EXPECT_TRUE(complete);
     }
+  }
+}
+
+// The pipeline's way: each stripe's inner triangles (every corner in rows only that stripe uses)
+// as one block of new vertices, counted ahead (prepare) where no welding is needed, then the
+// triangles across the stripes one by one; each vertex done after its last triangle.
+MeshStats streamed_in_blocks(const IndexedMesh& mesh, const std::vector<std::uint32_t>& group,
+                             const std::vector<std::uint8_t>& flip, std::uint32_t columns,
+                             std::uint32_t stripe_rows, bool positions_distinct,
+                             bool* counted_ahead) {
+  NullSink null;
+  g2s::StreamStats counter(null, false, positions_distinct);
+  const auto row = [&](g2s::Index v) { return v / columns; };
+  const auto stripe_of = [&](const Triangle& t) -> std::uint32_t {
+    for (g2s::Index v : t) {
+      if (row(v) % stripe_rows == 0 || row(v) / stripe_rows != row(t[0]) / stripe_rows) {
+        return g2s::kNoIndex;  // across stripes
+      }
+    }
+    return row(t[0]) / stripe_rows;
+  };
+  std::vector<std::vector<std::size_t>> blocks;
+  std::vector<std::size_t> across;
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const std::uint32_t s = stripe_of(mesh.triangles[t]);
+    if (s == g2s::kNoIndex) {
+      across.push_back(t);
+      continue;
+    }
+    if (blocks.size() <= s) blocks.resize(s + 1);
+    blocks[s].push_back(t);
+  }
+  std::vector<std::size_t> order;
+  for (const auto& b : blocks) order.insert(order.end(), b.begin(), b.end());
+  order.insert(order.end(), across.begin(), across.end());
+  std::vector<std::size_t> last(mesh.vertex_count(), 0);  // place in `order` of its last triangle
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    for (g2s::Index v : mesh.triangles[order[k]]) last[v] = k;
+  }
+  std::vector<std::uint32_t> number(mesh.vertex_count(), g2s::kNoIndex);
+  std::uint32_t next = 0;
+  std::size_t at = 0;  // place in `order`
+  *counted_ahead = true;
+  for (const auto& b : blocks) {
+    std::vector<g2s::Index> ids;
+    std::vector<double> xyz;
+    std::vector<Triangle> triangles;
+    std::vector<std::uint32_t> block_group;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> done;
+    std::vector<std::uint32_t> local(mesh.vertex_count(), g2s::kNoIndex);
+    for (std::size_t k = 0; k < b.size(); ++k, ++at) {
+      Triangle t = mesh.triangles[b[k]];
+      for (g2s::Index& v : t) {
+        if (local[v] == g2s::kNoIndex) {
+          local[v] = static_cast<std::uint32_t>(ids.size());
+          ids.push_back(v);
+          xyz.insert(xyz.end(), &mesh.xyz[3 * std::size_t{v}], &mesh.xyz[3 * std::size_t{v} + 3]);
+          number[v] = next + local[v];
+        }
+        if (last[v] == at) done.emplace_back(static_cast<std::uint32_t>(k), local[v]);
+        v = local[v];
+      }
+      triangles.push_back(t);
+      block_group.push_back(group[b[k]]);
+    }
+    const g2s::SinkBlock block{ids, xyz, triangles, block_group, done};
+    std::unique_ptr<g2s::SinkBlockWork> work = counter.prepare(block);
+    *counted_ahead = *counted_ahead && work != nullptr;
+    counter.block(block, next, 0, std::move(work));
+    next += static_cast<std::uint32_t>(ids.size());
+  }
+  for (; at < order.size(); ++at) {
+    stream_triangle(counter, mesh, order[at], group[order[at]], number, next);
+    for (g2s::Index v : mesh.triangles[order[at]]) {
+      if (last[v] == at) counter.vertex_done(number[v]);
+    }
+  }
+  counter.finish(flip);
+  EXPECT_TRUE(counter.complete());
+  return counter.stats();
+}
+
+// Blocks counted ahead give the counts of the same triangles streamed one by one: a torus of
+// stripes (one orientation group each, every other one flipped) with holes, reversed triangles,
+// duplicates and fins inside the stripes and across them. With welding, blocks go triangle by
+// triangle, with the same counts.
+TEST(StreamStats, BlocksCountedAheadAsComputeStatsCountsThem) {
+  const std::uint32_t rows = 120, columns = 90, stripe_rows = 20;
+  const auto [mesh, group] = defective_torus(rows, columns, stripe_rows, 7);
+  std::vector<std::uint8_t> flip(rows / stripe_rows + 1);
+  for (std::size_t g = 0; g < flip.size(); ++g) flip[g] = g % 2;
+  const MeshStats expected = g2s::compute_stats(as_written(mesh, group, flip));
+  ASSERT_GT(expected.holes, 0u);
+  ASSERT_GT(expected.orientation_conflicts, 0u);
+  ASSERT_GT(expected.non_manifold_edges, 0u);
+  ASSERT_GT(expected.non_manifold_vertices, 0u);
+  ASSERT_GT(expected.duplicate_triangles, 0u);
+  for (bool distinct : {true, false}) {
+    bool counted_ahead = false;
+    expect_same(
+        streamed_in_blocks(mesh, group, flip, columns, stripe_rows, distinct, &counted_ahead),
+        expected, distinct ? "counted ahead" : "welded");
+    EXPECT_EQ(counted_ahead, distinct);
   }
 }
 
