@@ -298,13 +298,15 @@ class SeamStitcher {
 struct Stitcher::Impl {
   Impl(const TileSource& s, const PipelineOptions& o, MeshSink& k)
       : source(s), options(o), sink(k), stitcher(s, o), live(s.tiles().size()) {}
+  // Read by prepare() on other threads while add() runs: set once, and kept off the cache lines
+  // that add() writes, so the threads do not pass those lines back and forth.
   const TileSource& source;
   const PipelineOptions& options;
   MeshSink& sink;
-  SeamStitcher stitcher;
-  LiveMesh live;
   std::vector<SeamReach> reach;  // per tile
   Vec3 origin{0, 0, 0};
+  alignas(64) SeamStitcher stitcher;
+  LiveMesh live;
   ReleaseCounts released;
   PipelineSummary out;
   std::size_t next = 0;  // the tile add() expects
