@@ -297,11 +297,11 @@ class SeamStitcher {
 
 struct Stitcher::Impl {
   Impl(const TileSource& s, const PipelineOptions& o, MeshSink& k)
-      : source(s), options(o), sink(k), stitcher(s, o), live(s.tiles().size()) {}
+      : source(s), options(o), sink(k), stitcher(s, options), live(s.tiles().size()) {}
   // Read by prepare() on other threads while add() runs: set once, and kept off the cache lines
   // that add() writes, so the threads do not pass those lines back and forth.
   const TileSource& source;
-  const PipelineOptions& options;
+  const PipelineOptions options;  // a copy: callers may pass a temporary
   MeshSink& sink;
   std::vector<SeamReach> reach;  // per tile
   Vec3 origin{0, 0, 0};
