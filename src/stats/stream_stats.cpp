@@ -734,14 +734,6 @@ struct StreamStats::Impl {
     borders.compact(border_nodes);
   }
 
-  void for_each_wedge(const Open& v, const auto& visit) const {
-    const std::uint32_t held = std::min(v.wedges, kInlineWedges);
-    for (std::uint32_t k = 0; k < held; ++k) visit(v.inline_wedges[k]);
-    if (v.overflow != kNoIndex) {
-      for (const Wedge& w : overflow[v.overflow]) visit(w);
-    }
-  }
-
   void add_wedge(Open& v, const Wedge& w) {
     if (v.wedges < kInlineWedges) {
       v.inline_wedges[v.wedges++] = w;
@@ -762,12 +754,9 @@ struct StreamStats::Impl {
 
   // A later copy of a vertex set already in the star of its first corner.
   bool duplicate(const Triangle& rep, std::uint32_t first) const {
-    bool found = false;
-    for_each_wedge(open(first), [&](const Wedge& w) {
-      found =
-          found || (w.next == rep[1] && w.prev == rep[2]) || (w.next == rep[2] && w.prev == rep[1]);
-    });
-    return found;
+    const Open& v = open(first);
+    return holds_triangle({v.inline_wedges, std::min(v.wedges, kInlineWedges)}, rep[1], rep[2]) ||
+           (v.overflow != kNoIndex && holds_triangle(overflow[v.overflow], rep[1], rep[2]));
   }
 
   void add_triangle(const Triangle& numbers, const std::array<const double*, 3>& xyz,
