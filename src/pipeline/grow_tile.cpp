@@ -25,10 +25,11 @@ namespace {
 // Judges the fans of the suspects deeper than `depth` (see above) and deletes the triangles of
 // all but one fan; the suspects left, and those a deletion may have split, stay in second_fans.
 // out.second_fans[0, halo_corners) are corners of triangles left out at the halo.
-void clean_deep_fans(TileGrowth& out, const TileBox& box, double depth, std::size_t halo_corners) {
+void clean_deep_fans(TileGrowth& out, const TileFaces& faces, double depth,
+                     std::size_t halo_corners) {
   const std::size_t n = out.points.size();
   std::vector<std::uint8_t> deep(n, 0);
-  for (std::size_t k = 0; k < n; ++k) deep[k] = box_depth(box, &out.points.xyz[3 * k]) > depth;
+  for (std::size_t k = 0; k < n; ++k) deep[k] = faces.depth(&out.points.xyz[3 * k]) > depth;
   for (std::size_t k = 0; k < halo_corners; ++k) deep[out.second_fans[k]] = 0;
   std::vector<Index> judged, left;
   for (Index v : out.second_fans) (deep[v] ? judged : left).push_back(v);
@@ -57,8 +58,8 @@ void clean_deep_fans(TileGrowth& out, const TileBox& box, double depth, std::siz
 // Moves the triangles whose corners all lie deeper than `depth` (out of reach of every seam and
 // of the clean-up's release margin: final already) to the front, in order, and counts them, so
 // that the stitcher hands them straight to the output.
-void put_final_first(TileGrowth& out, const TileBox& box, double depth) {
-  auto deep = [&](Index v) { return box_depth(box, &out.points.xyz[3 * std::size_t{v}]) > depth; };
+void put_final_first(TileGrowth& out, const TileFaces& faces, double depth) {
+  auto deep = [&](Index v) { return faces.depth(&out.points.xyz[3 * std::size_t{v}]) > depth; };
   std::vector<Triangle> rest;
   std::vector<std::uint32_t> rest_group;
   std::size_t final_count = 0;
@@ -163,8 +164,9 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
   grown = GrowResult();
   point_of = std::vector<Index>();
   dense = std::vector<std::uint32_t>();
-  clean_deep_fans(out, box, seam_depth(tiles, tile, options), halo_corners);
-  put_final_first(out, box, seam_depth(tiles, tile, options, true));
+  const TileFaces faces = tile_faces(tiles, tile);
+  clean_deep_fans(out, faces, seam_depth(tiles, tile, options), halo_corners);
+  put_final_first(out, faces, seam_depth(tiles, tile, options, true));
   out.report.seconds_grow =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - grow_start).count();
   return out;

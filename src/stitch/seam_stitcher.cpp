@@ -304,6 +304,7 @@ struct Stitcher::Impl {
   const PipelineOptions options;  // a copy: callers may pass a temporary
   MeshSink& sink;
   std::vector<SeamReach> reach;  // per tile
+  std::vector<TileFaces> faces;  // per tile
   Vec3 origin{0, 0, 0};
   alignas(64) SeamStitcher stitcher;
   LiveMesh live;
@@ -317,9 +318,8 @@ struct Stitcher::Impl {
   std::uint32_t last_step(std::size_t tile, const double* p, std::span<const std::size_t> later,
                           double inside, bool margin) const {
     const std::span<const TileInfo> tiles = source.tiles();
-    const TileBox& box = tiles[tile].box;
-    // Every other box lies outside this one: a point deeper inside than any reach is done.
-    if (box_depth(box, p) > inside) return static_cast<std::uint32_t>(tile);
+    // Every other box lies beyond an open face: a point deeper than any reach is done.
+    if (faces[tile].depth(p) > inside) return static_cast<std::uint32_t>(tile);
     for (std::size_t k = later.size(); k-- > 0;) {
       const SeamReach& r = reach[later[k]];
       if (box_distance(tiles[later[k]].box, p) <= r.touch + (margin ? r.margin : 0.0)) {
@@ -339,6 +339,7 @@ Stitcher::Stitcher(const TileSource& source, const PipelineOptions& options, Mes
   impl_->out.tiles = tiles.size();
   for (std::size_t t = 0; t < tiles.size(); ++t) {
     impl_->reach.push_back(seam_reach(tiles, t, options));
+    impl_->faces.push_back(tile_faces(tiles, t));
   }
   const TileBox bounds = tiles_bounds(tiles);
   impl_->origin = {0.5 * (bounds.lo[0] + bounds.hi[0]), 0.5 * (bounds.lo[1] + bounds.hi[1]),
@@ -434,7 +435,7 @@ PreparedTile Stitcher::prepare(std::size_t tile, TileGrowth growth) const {
   for (std::size_t k = 0; k < n; ++k) {
     const double* p = &points.xyz[3 * k];
     const std::uint32_t release = m.last_step(tile, p, later, inside, true);
-    const bool listed = release != tile || box_depth(tiles[tile].box, p) <= unreachable;
+    const bool listed = release != tile || m.faces[tile].depth(p) <= unreachable;
     if (!listed && held_at[k] == kNoIndex) continue;
     const std::uint32_t finish =
         release == tile ? release : m.last_step(tile, p, later, inside, false);
