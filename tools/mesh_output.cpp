@@ -283,6 +283,7 @@ void write_and_report(const TileSource& source,
             .raw("grow_and_stitch", stage({mesh.wall - timed.time.wall, mesh.cpu - timed.time.cpu}))
             .raw("grow", JsonObject().fixed("cpu", summary.cpu_seconds_grow, 3).str())
             .raw("stitch", JsonObject().fixed("cpu", summary.cpu_seconds_stitch, 3).str())
+            .raw("write", JsonObject().fixed("cpu", writer.write_cpu_seconds(), 3).str())
             .raw("output", stage(timed.time))
             .raw("summary", JsonObject()
                                 .fixed("wall", measured.wall, 3)

@@ -84,7 +84,10 @@ class TemporaryPath {
 // failures throw Error(write_failed, "<target>: <what>: <strerror>"), e.g. missing or read-only
 // folder, disk full (ENOSPC) or file size limit (EFBIG). A symbolic link is written through (the
 // file it names is replaced, the link stays); an existing target that is not a regular file
-// (device, FIFO, socket) throws Error(write_failed) and is left alone.
+// (device, FIFO, socket) throws Error(write_failed) and is left alone. After write_behind(),
+// full buffers are written on a thread of their own while the caller fills the next; a failed
+// write then throws at the next call that hands a buffer over, or at flush or commit.
+class WriteBehind;
 class AtomicFile {
  public:
   explicit AtomicFile(const std::filesystem::path& target);
@@ -100,11 +103,15 @@ class AtomicFile {
   void flush();
   void read_at(std::uint64_t offset, void* data, std::size_t bytes) const;  // flushed bytes only
   void commit();
+  void write_behind();
+  double write_behind_cpu_seconds() const;  // the writing thread's so far (0 without it)
   const std::filesystem::path& target() const { return target_; }
   const std::filesystem::path& temporary() const { return temporary_; }
 
  private:
   void flush_buffer();
+  void write_out(const char* p, std::size_t bytes);  // at written_, on this thread
+  void wait_behind() const;                          // every buffer handed over is written
   std::filesystem::path target_;
   std::filesystem::path destination_;  // target_ with symbolic links followed
   std::filesystem::path temporary_;
@@ -113,6 +120,8 @@ class AtomicFile {
   std::uint64_t written_ = 0;  // bytes handed to the OS
   bool committed_ = false;
   int registry_slot_ = -1;  // in the interrupt handler's list of temporaries
+  std::unique_ptr<WriteBehind> behind_;
+  double behind_cpu_ = 0;  // the writing thread's CPU seconds, once it is gone
 };
 
 // Streams triangles to STL (binary or ASCII) as they come: memory stays constant whatever the
@@ -161,6 +170,9 @@ class MeshStreamWriter final : public MeshSink {
   // rounding to float moves one.
   double largest_coordinate() const;
   double float_rounding() const;
+  // CPU seconds of the thread that wrote a binary STL's facets beside the caller (0 for the
+  // other formats, whose files are written by finish()).
+  double write_cpu_seconds() const;
 
  private:
   struct Impl;

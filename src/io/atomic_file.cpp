@@ -17,6 +17,7 @@
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
 #include "io/temp_registry.hpp"
+#include "io/write_behind.hpp"
 
 namespace g2s {
 namespace {
@@ -79,26 +80,43 @@ AtomicFile::AtomicFile(const std::filesystem::path& target) : target_(target) {
 }
 
 AtomicFile::~AtomicFile() {
+  behind_.reset();  // its thread may be writing to fd_
   if (fd_ >= 0) ::close(fd_);
   if (!committed_ && !temporary_.empty()) ::unlink(temporary_.c_str());
   unregister_temporary(registry_slot_);
 }
 
-void AtomicFile::flush_buffer() {
-  const char* p = buffer_.data();
-  std::size_t left = buffer_.size();
-  while (left > 0) {
-    const ssize_t n = ::write(fd_, p, left);
+void AtomicFile::write_out(const char* p, std::size_t bytes) {
+  while (bytes > 0) {
+    const ssize_t n = ::pwrite(fd_, p, bytes, static_cast<off_t>(written_));
     if (n < 0) {
       if (errno == EINTR) continue;
       fail_write(target_, "write failed", errno);
     }
     if (n == 0) fail_write(target_, "write failed", EIO);
     p += n;
-    left -= static_cast<std::size_t>(n);
+    bytes -= static_cast<std::size_t>(n);
     written_ += static_cast<std::uint64_t>(n);
   }
-  buffer_.clear();
+}
+
+void AtomicFile::wait_behind() const {
+  if (!behind_) return;
+  if (const int err = behind_->wait(); err != 0) fail_write(target_, "write failed", err);
+}
+
+void AtomicFile::flush_buffer() {
+  if (!behind_) {
+    write_out(buffer_.data(), buffer_.size());
+    buffer_.clear();
+    return;
+  }
+  const std::size_t bytes = buffer_.size();
+  if (bytes == 0) return;
+  if (const int err = behind_->submit(buffer_, written_); err != 0) {
+    fail_write(target_, "write failed", err);
+  }
+  written_ += bytes;
 }
 
 void AtomicFile::write(const void* data, std::size_t bytes) {
@@ -107,19 +125,21 @@ void AtomicFile::write(const void* data, std::size_t bytes) {
   if (buffer_.size() + bytes > kBufferSize) {
     flush_buffer();
     // A block as large as the buffer goes straight to the OS.
-    while (bytes >= kBufferSize) {
-      const ssize_t n = ::write(fd_, p, bytes);
-      if (n < 0) {
-        if (errno == EINTR) continue;
-        fail_write(target_, "write failed", errno);
-      }
-      if (n == 0) fail_write(target_, "write failed", EIO);
-      p += n;
-      bytes -= static_cast<std::size_t>(n);
-      written_ += static_cast<std::uint64_t>(n);
+    if (bytes >= kBufferSize) {
+      wait_behind();
+      write_out(p, bytes);
+      return;
     }
   }
   buffer_.insert(buffer_.end(), p, p + bytes);
+}
+
+void AtomicFile::write_behind() {
+  if (!behind_) behind_ = std::make_unique<WriteBehind>(fd_, kBufferSize);
+}
+
+double AtomicFile::write_behind_cpu_seconds() const {
+  return behind_ ? behind_->cpu_seconds() : behind_cpu_;
 }
 
 void AtomicFile::write_at(std::uint64_t offset, const void* data, std::size_t bytes) {
@@ -129,6 +149,7 @@ void AtomicFile::write_at(std::uint64_t offset, const void* data, std::size_t by
                                            target_.string(), offset, bytes, size()));
   }
   const char* p = static_cast<const char*>(data);
+  wait_behind();
   // The part already handed to the OS.
   while (bytes > 0 && offset < written_) {
     const std::size_t part =
@@ -150,6 +171,7 @@ void AtomicFile::write_at(std::uint64_t offset, const void* data, std::size_t by
 void AtomicFile::flush() {
   if (fd_ < 0) fail_write(target_, "write after commit", EBADF);
   flush_buffer();
+  wait_behind();
 }
 
 void AtomicFile::read_at(std::uint64_t offset, void* data, std::size_t bytes) const {
@@ -157,6 +179,7 @@ void AtomicFile::read_at(std::uint64_t offset, void* data, std::size_t bytes) co
     throw Error(Exit::failure, fmt::format("{}: read_at({}, {} bytes) beyond the {} bytes flushed",
                                            target_.string(), offset, bytes, written_));
   }
+  wait_behind();
   char* p = static_cast<char*>(data);
   while (bytes > 0) {
     const ssize_t n = ::pread(fd_, p, bytes, static_cast<off_t>(offset));
@@ -178,6 +201,9 @@ std::uint64_t AtomicFile::size() const {
 void AtomicFile::commit() {
   if (fd_ < 0) fail_write(target_, "commit after commit", EBADF);
   flush_buffer();
+  wait_behind();
+  behind_cpu_ = write_behind_cpu_seconds();
+  behind_.reset();
   const int fd = fd_;
   fd_ = -1;
   if (::close(fd) != 0) fail_write(target_, "write failed", errno);

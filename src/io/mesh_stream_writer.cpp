@@ -136,6 +136,7 @@ struct MeshStreamWriter::Impl {
   Impl(const std::filesystem::path& t, MeshFormat f) : target(t), format(f) {
     if (format == MeshFormat::stl_binary) {
       stl = std::make_unique<AtomicFile>(t);
+      stl->write_behind();  // the stitcher fills the facets; another thread writes them
       char header[kStlHeaderBytes] = {};
       const char text[] = "binary STL written by g2s";
       std::memcpy(header, text, sizeof text - 1);
@@ -218,6 +219,10 @@ MeshStreamWriter::MeshStreamWriter(const std::filesystem::path& target, MeshForm
     : impl_(std::make_unique<Impl>(target, format)) {}
 
 MeshStreamWriter::~MeshStreamWriter() = default;
+
+double MeshStreamWriter::write_cpu_seconds() const {
+  return impl_->stl ? impl_->stl->write_behind_cpu_seconds() : 0.0;
+}
 
 void MeshStreamWriter::vertex(Index, const double xyz[3]) {
   Impl& m = *impl_;

@@ -275,33 +275,49 @@ TEST_F(IoAtomicFile, ReplacesAnExistingFile) {
   EXPECT_EQ(file_bytes(target), "new");
 }
 
+// With write_behind(), the same bytes: full buffers are written on another thread, and write_at
+// and read_at wait for them.
 TEST_F(IoAtomicFile, WriteAtPatchesFlushedAndBufferedBytes) {
-  const fs::path target = dir_ / "patch.bin";
-  std::string expected;
-  {
-    g2s::AtomicFile file(target);
-    const std::string block(1000, 'a');
-    for (int i = 0; i < 1500; ++i) {  // 1.5 MB in small writes: part flushed, part buffered
-      file.write(block.data(), block.size());
-      expected += block;
+  for (const bool behind : {false, true}) {
+    SCOPED_TRACE(behind ? "write behind" : "on the caller's thread");
+    const fs::path target = dir_ / "patch.bin";
+    std::string expected;
+    {
+      g2s::AtomicFile file(target);
+      if (behind) file.write_behind();
+      const std::string block(1000, 'a');
+      for (int i = 0; i < 1500; ++i) {  // 1.5 MB in small writes: part flushed, part buffered
+        file.write(block.data(), block.size());
+        expected += block;
+      }
+      const std::string big(3 << 20, 'b');  // a block larger than the buffer
+      file.write(big.data(), big.size());
+      expected += big;
+      for (int i = 0; i < 2500; ++i) {  // 2.5 MB more: buffers handed over while one is written
+        const std::string line = fmt::format("{:09}\n", i);
+        file.write(line.data(), line.size());
+        expected += line;
+      }
+      file.write("tail", 4);
+      expected += "tail";
+      ASSERT_EQ(file.size(), expected.size());
+      const auto patch = [&](std::uint64_t at, std::string_view s) {
+        file.write_at(at, s.data(), s.size());
+        expected.replace(at, s.size(), s);
+      };
+      patch(0, "HEAD");                      // long flushed
+      patch((1u << 20) - 2, "SPAN");         // across the first flush
+      patch(expected.size() - 6, "XXYYZZ");  // the last bytes, partly still buffered
+      EXPECT_THROW(file.write_at(expected.size() - 1, "ab", 2), g2s::Error);
+      file.flush();
+      std::string back(expected.size(), '\0');
+      file.read_at(0, back.data(), back.size());
+      EXPECT_EQ(back, expected);
+      file.commit();
+      EXPECT_GE(file.write_behind_cpu_seconds(), 0.0);
     }
-    const std::string big(3 << 20, 'b');  // a block larger than the buffer
-    file.write(big.data(), big.size());
-    expected += big;
-    file.write("tail", 4);
-    expected += "tail";
-    ASSERT_EQ(file.size(), expected.size());
-    const auto patch = [&](std::uint64_t at, std::string_view s) {
-      file.write_at(at, s.data(), s.size());
-      expected.replace(at, s.size(), s);
-    };
-    patch(0, "HEAD");                      // long flushed
-    patch((1u << 20) - 2, "SPAN");         // across the first flush
-    patch(expected.size() - 6, "XXYYZZ");  // the last bytes, partly still buffered
-    EXPECT_THROW(file.write_at(expected.size() - 1, "ab", 2), g2s::Error);
-    file.commit();
+    EXPECT_EQ(file_bytes(target), expected);
   }
-  EXPECT_EQ(file_bytes(target), expected);
 }
 
 TEST_F(IoAtomicFile, UncommittedFileRemovesItsTemporary) {
@@ -408,6 +424,19 @@ TEST_F(IoAtomicFile, DiskFullLeavesNothing) {
                                        g2s::PlyPointWriter writer(ply, 10000);
                                        for (int i = 0; i < 10000; ++i) writer.add(1, 2, 3);
                                        writer.finish();
+                                     }),
+            0);
+  // Written behind: the failure comes from the writing thread and surfaces on the caller's.
+  const fs::path behind = dir_ / "behind.bin";
+  EXPECT_EQ(run_with_file_size_limit(256 << 10, behind,
+                                     [&] {
+                                       g2s::AtomicFile file(behind);
+                                       file.write_behind();
+                                       const std::string line(50, 'x');
+                                       for (int i = 0; i < 100000; ++i) {
+                                         file.write(line.data(), line.size());
+                                       }
+                                       file.commit();
                                      }),
             0);
   EXPECT_TRUE(entries().empty()) << "target or temporary left behind";
