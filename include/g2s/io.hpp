@@ -170,8 +170,8 @@ class MeshStreamWriter final : public MeshSink {
   // rounding to float moves one.
   double largest_coordinate() const;
   double float_rounding() const;
-  // CPU seconds of the thread that wrote a binary STL's facets beside the caller (0 for the
-  // other formats, whose files are written by finish()).
+  // CPU seconds of the threads that wrote the binary STL's facets, or the other formats'
+  // spills, beside the caller (finish() writes the rest).
   double write_cpu_seconds() const;
 
  private:

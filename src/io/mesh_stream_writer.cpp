@@ -23,6 +23,7 @@
 #include "g2s/io.hpp"
 #include "io/le_bytes.hpp"
 #include "io/stl_record.hpp"
+#include "io/write_behind.hpp"
 
 namespace g2s {
 namespace {
@@ -39,8 +40,10 @@ class SpillFile {
     fd_ = ::open(path_.path().c_str(), O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
     if (fd_ < 0) fail("cannot create a spill file");
     buffer_.reserve(kBufferSize);
+    behind_ = std::make_unique<WriteBehind>(fd_, kBufferSize);
   }
   ~SpillFile() {
+    behind_.reset();  // its thread may be writing to fd_
     if (fd_ >= 0) ::close(fd_);
   }
   SpillFile(const SpillFile&) = delete;
@@ -56,6 +59,7 @@ class SpillFile {
   template <typename Each>
   void read_back(std::size_t record_bytes, Each each) {
     flush();
+    if (const int err = behind_->wait(); err != 0) fail("cannot write the spill file", err);
     std::vector<char> chunk(kBufferSize / record_bytes * record_bytes);
     for (std::uint64_t offset = 0; offset < size_;) {
       const auto want =
@@ -72,29 +76,29 @@ class SpillFile {
       offset += want;
     }
   }
+  double write_cpu_seconds() const { return behind_->cpu_seconds(); }
 
  private:
+  // The buffer goes to the file on the write-behind thread (the stitcher fills the spills).
   void flush() {
-    std::size_t done = 0;
-    while (done < buffer_.size()) {
-      const ssize_t n = ::write(fd_, buffer_.data() + done, buffer_.size() - done);
-      if (n < 0 && errno == EINTR) continue;
-      if (n < 0) fail("cannot write the spill file");
-      done += static_cast<std::size_t>(n);
+    const std::size_t bytes = buffer_.size();
+    if (bytes == 0) return;
+    if (const int err = behind_->submit(buffer_, size_); err != 0) {
+      fail("cannot write the spill file", err);
     }
-    size_ += buffer_.size();
-    buffer_.clear();
+    size_ += bytes;
   }
-  [[noreturn]] void fail(const char* what) const {
+  [[noreturn]] void fail(const char* what, int err = errno) const {
     throw Error(Exit::write_failed,
-                fmt::format("{}: {}: {}", target_.string(), what, std::strerror(errno)));
+                fmt::format("{}: {}: {}", target_.string(), what, std::strerror(err)));
   }
 
   std::filesystem::path target_;
   TemporaryPath path_;
   int fd_ = -1;
   std::vector<char> buffer_;
-  std::uint64_t size_ = 0;
+  std::uint64_t size_ = 0;  // bytes handed to the write-behind thread
+  std::unique_ptr<WriteBehind> behind_;
 };
 
 bool survives_float(double v) {
@@ -221,7 +225,12 @@ MeshStreamWriter::MeshStreamWriter(const std::filesystem::path& target, MeshForm
 MeshStreamWriter::~MeshStreamWriter() = default;
 
 double MeshStreamWriter::write_cpu_seconds() const {
-  return impl_->stl ? impl_->stl->write_behind_cpu_seconds() : 0.0;
+  const Impl& m = *impl_;
+  double seconds = m.stl ? m.stl->write_behind_cpu_seconds() : 0.0;
+  for (const auto* spill : {m.runs.get(), m.triangles.get(), m.vertices.get()}) {
+    if (spill) seconds += spill->write_cpu_seconds();
+  }
+  return seconds;
 }
 
 void MeshStreamWriter::vertex(Index, const double xyz[3]) {

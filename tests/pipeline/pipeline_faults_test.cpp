@@ -106,6 +106,12 @@ TEST_F(PipelineFaults, FullDiskWhileWritingTheMesh) {
   EXPECT_FALSE(fs::exists(dir_ / "out.stl"));
   EXPECT_TRUE(temporaries().empty());
   EXPECT_NE(stitch.err.find("out.stl"), std::string::npos) << stitch.err;
+  // PLY: the 1.9 MB spill of triangles fails first, on its write-behind thread.
+  const g2s::test_support::CliRun ply = run({"stitch", "s.store", "-o", "out.ply"}, 1024 * 1024);
+  EXPECT_EQ(ply.code, 4) << ply.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out.ply"));
+  EXPECT_TRUE(temporaries().empty());
+  EXPECT_NE(ply.err.find("out.ply"), std::string::npos) << ply.err;
 }
 
 TEST_F(PipelineFaults, InterruptedStagesLeaveNothingAndGrowResumes) {
