@@ -42,6 +42,13 @@ class TimedFinish final : public MeshSink {
     next_.triangle(corners, xyz, group);
   }
   void vertex_done(std::uint32_t vertex) override { next_.vertex_done(vertex); }
+  std::unique_ptr<SinkBlockWork> prepare(const SinkBlock& block) const override {
+    return next_.prepare(block);
+  }
+  void block(const SinkBlock& block, std::uint32_t first_vertex, std::uint32_t first_group,
+             std::unique_ptr<SinkBlockWork> work) override {
+    next_.block(block, first_vertex, first_group, std::move(work));
+  }
   void finish(std::span<const std::uint8_t> flip) override {
     const auto start = std::chrono::steady_clock::now();
     const double cpu = cpu_seconds();

@@ -164,6 +164,10 @@ class MeshStreamWriter final : public MeshSink {
   void vertex(Index id, const double xyz[3]) override;
   void triangle(const Triangle& corners, const std::array<const double*, 3>& xyz,
                 std::uint32_t group) override;
+  // Binary STL: a block's facet normals are worked out ahead (12 bytes a triangle).
+  std::unique_ptr<SinkBlockWork> prepare(const SinkBlock& block) const override;
+  void block(const SinkBlock& block, std::uint32_t first_vertex, std::uint32_t first_group,
+             std::unique_ptr<SinkBlockWork> work) override;
   void finish(std::span<const std::uint8_t> flip) override;
   std::uint64_t triangles() const;
   // For the STL rounding warning: the largest |coordinate| of the vertices, and the most

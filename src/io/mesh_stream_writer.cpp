@@ -154,6 +154,19 @@ struct MeshStreamWriter::Impl {
   }
   template <typename Flipped>
   void finish_binary_stl(const Flipped& flipped);
+  // Binary STL: one facet, facing as its group does so far.
+  void add_facet(const char record[kStlRecordBytes], std::uint32_t group) {
+    if (triangle_count >= std::numeric_limits<std::uint32_t>::max()) {
+      throw Error(Exit::write_failed,
+                  fmt::format("{}: more than {} triangles do not fit in a binary STL",
+                              target.string(), std::numeric_limits<std::uint32_t>::max()));
+    }
+    stl->write(record, kStlRecordBytes);
+    if (run_count > 0 && run_group != group) end_run();
+    run_group = group;
+    ++run_count;
+    ++triangle_count;
+  }
   void end_run() {
     if (run_count == 0) return;
     const std::uint32_t record[2] = {run_group, run_count};
@@ -248,18 +261,9 @@ void MeshStreamWriter::triangle(const Triangle& corners, const std::array<const 
                                 std::uint32_t group) {
   Impl& m = *impl_;
   if (m.format == MeshFormat::stl_binary) {
-    if (m.triangle_count >= std::numeric_limits<std::uint32_t>::max()) {
-      throw Error(Exit::write_failed,
-                  fmt::format("{}: more than {} triangles do not fit in a binary STL",
-                              m.target.string(), std::numeric_limits<std::uint32_t>::max()));
-    }
     char record[kStlRecordBytes];
     stl_record(xyz[0], xyz[1], xyz[2], record);
-    m.stl->write(record, sizeof record);
-    if (m.run_count > 0 && m.run_group != group) m.end_run();
-    m.run_group = group;
-    ++m.run_count;
-    ++m.triangle_count;
+    m.add_facet(record, group);
     return;
   }
   ++m.triangle_count;
@@ -276,6 +280,44 @@ void MeshStreamWriter::triangle(const Triangle& corners, const std::array<const 
     for (int k = 0; k < 3; ++k) record.xyz[3 * c + k] = static_cast<float>(xyz[c][k]);
   }
   m.triangles->append(&record, sizeof record);
+}
+
+namespace {
+// A block's binary STL facet normals, worked out ahead.
+struct StlNormals final : SinkBlockWork {
+  std::vector<float> normals;  // 3 per triangle
+};
+}  // namespace
+
+std::unique_ptr<SinkBlockWork> MeshStreamWriter::prepare(const SinkBlock& block) const {
+  if (impl_->format != MeshFormat::stl_binary) return nullptr;
+  auto work = std::make_unique<StlNormals>();
+  work->normals.resize(3 * block.triangles.size());
+  for (std::size_t k = 0; k < block.triangles.size(); ++k) {
+    const Triangle& t = block.triangles[k];
+    stl_normal(&block.xyz[3 * std::size_t{t[0]}], &block.xyz[3 * std::size_t{t[1]}],
+               &block.xyz[3 * std::size_t{t[2]}], &work->normals[3 * k]);
+  }
+  return work;
+}
+
+void MeshStreamWriter::block(const SinkBlock& block, std::uint32_t first_vertex,
+                             std::uint32_t first_group, std::unique_ptr<SinkBlockWork> work) {
+  if (!work) {
+    MeshSink::block(block, first_vertex, first_group, nullptr);
+    return;
+  }
+  // Only prepare() makes this sink's work.
+  const std::vector<float>& normals = static_cast<const StlNormals&>(*work).normals;
+  Impl& m = *impl_;
+  for (std::size_t v = 0; v < block.ids.size(); ++v) vertex(block.ids[v], &block.xyz[3 * v]);
+  for (std::size_t k = 0; k < block.triangles.size(); ++k) {
+    const Triangle& t = block.triangles[k];
+    char record[kStlRecordBytes];
+    stl_record(&block.xyz[3 * std::size_t{t[0]}], &block.xyz[3 * std::size_t{t[1]}],
+               &block.xyz[3 * std::size_t{t[2]}], &normals[3 * k], record);
+    m.add_facet(record, first_group + block.group[k]);
+  }
 }
 
 void MeshStreamWriter::finish(std::span<const std::uint8_t> flip) {

@@ -55,6 +55,21 @@ void stl_record(const double a[3], const double b[3], const double c[3], char re
   io::put_le(p, std::uint16_t{0});
 }
 
+void stl_normal(const double a[3], const double b[3], const double c[3], float normal[3]) {
+  float corners[9];
+  facet(a, b, c, corners, normal);
+}
+
+void stl_record(const double a[3], const double b[3], const double c[3], const float normal[3],
+                char record[50]) {
+  char* p = record;
+  for (int k = 0; k < 3; ++k) p = io::put_le(p, normal[k]);
+  for (const double* corner : {a, b, c}) {
+    for (int k = 0; k < 3; ++k) p = io::put_le(p, static_cast<float>(corner[k]));
+  }
+  io::put_le(p, std::uint16_t{0});
+}
+
 StlWriter::StlWriter(const std::filesystem::path& target, bool ascii)
     : file_(target), ascii_(ascii) {
   if (ascii_) {
