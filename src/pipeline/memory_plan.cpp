@@ -61,8 +61,8 @@ MemoryPlan plan_memory(std::uint64_t budget_bytes, int threads) {
   const std::size_t growing = std::min(workers, static_cast<std::size_t>(growers));
   // Grown tiles wait for the stitcher, which takes them in order: while one slow tile grows,
   // the other threads go on only as far as tiles may wait. As many may wait as threads grow,
-  // when the budget holds them (at least one): on alpe (13 tiles of 84k-757k points, 2
-  // threads), one waiting tile left a thread idle behind each slow tile, 2.6 s of a 46 s run.
+  // when the budget holds them (at least one): a timeline of alpe (13 tiles of 84k-757k points,
+  // 2 threads) showed a thread idle behind slow tiles for 2.6 s of a 46 s run.
   const double room =
       usable / tile_size - static_cast<double>(growing) * kGrowBytesPerPoint - kStitchBytesPerPoint;
   const auto waiting = static_cast<std::size_t>(std::max(1.0, room / kWaitingBytesPerPoint));
