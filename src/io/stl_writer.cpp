@@ -45,19 +45,15 @@ void facet(const double a[3], const double b[3], const double c[3], float corner
 
 }  // namespace
 
-void stl_record(const double a[3], const double b[3], const double c[3], char record[50]) {
-  float corners[9];
-  float normal[3];
-  facet(a, b, c, corners, normal);
-  char* p = record;
-  for (float f : normal) p = io::put_le(p, f);
-  for (float f : corners) p = io::put_le(p, f);
-  io::put_le(p, std::uint16_t{0});
-}
-
 void stl_normal(const double a[3], const double b[3], const double c[3], float normal[3]) {
   float corners[9];
   facet(a, b, c, corners, normal);
+}
+
+void stl_record(const double a[3], const double b[3], const double c[3], char record[50]) {
+  float normal[3];
+  stl_normal(a, b, c, normal);
+  stl_record(a, b, c, normal, record);
 }
 
 void stl_record(const double a[3], const double b[3], const double c[3], const float normal[3],
