@@ -63,8 +63,14 @@ void release_finished(LiveMesh& live, std::size_t step, const Vec3& origin, Mesh
     counts.non_manifold.vertices_unjudged += nm.vertices_unjudged;
     for (Index s : deferred) live.flags[s] |= LiveMesh::kSuspect;
   }
+  // Both loops below are bound by memory latency (the corners' slots lie scattered): each starts
+  // loading what it will read a few iterations ahead.
+  constexpr std::size_t kAhead = 8;
   std::size_t kept = 0;
   for (std::size_t t = 0; t < live.triangles.size(); ++t) {
+    if (t + kAhead < live.triangles.size() && live.due[t + kAhead] <= step) {
+      for (Index s : live.triangles[t + kAhead]) live.prefetch_corner(s);
+    }
     const bool removed = !dead.empty() && dead[t];
     const bool released = live.due[t] <= step;
     if (!removed && !released) {
@@ -90,8 +96,23 @@ void release_finished(LiveMesh& live, std::size_t step, const Vec3& origin, Mesh
   live.triangles.resize(kept);
   live.group.resize(kept);
   live.due.resize(kept);
-  for (std::uint32_t s : maybe_free) {
-    if ((live.flags[s] & LiveMesh::kReleased) && live.uses[s] == 0) {
+  const auto may_free = [&](std::uint32_t s) {
+    return (live.flags[s] & LiveMesh::kReleased) && live.uses[s] == 0;
+  };
+  for (std::size_t k = 0; k < maybe_free.size(); ++k) {
+    // The slot's flags, uses and id two steps ahead, then the map entry its id hashes to.
+    if (k + 2 * kAhead < maybe_free.size()) {
+      const std::uint32_t s = maybe_free[k + 2 * kAhead];
+      __builtin_prefetch(&live.flags[s]);
+      __builtin_prefetch(&live.uses[s]);
+      __builtin_prefetch(&live.id[s]);
+    }
+    if (k + kAhead < maybe_free.size()) {
+      const std::uint32_t s = maybe_free[k + kAhead];
+      if (may_free(s) && !(live.flags[s] & LiveMesh::kUnlisted)) live.slot_of.prefetch(live.id[s]);
+    }
+    const std::uint32_t s = maybe_free[k];
+    if (may_free(s)) {
       if (live.number[s] != kNoIndex) sink.vertex_done(live.number[s]);
       live.free_slot(s);
     }

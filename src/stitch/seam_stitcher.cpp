@@ -65,14 +65,18 @@ class SeamStitcher {
     local_of_.clear();
     // Positions in a float frame at the tile's centre.
     const LocalFrame frame(box.lo, box.hi);
+    // Returns the point's place in ids_.
     auto take = [&](Index id, bool in_band, const double* p) {
-      if (local_of_.insert(id, static_cast<std::uint32_t>(ids_.size())) != ids_.size()) return;
+      const auto next = static_cast<std::uint32_t>(ids_.size());
+      const std::uint32_t at = local_of_.insert(id, next);
+      if (at != next) return at;
       // A band point is live (within the tile's reach, so not finished): flag it for the preload.
       const std::uint32_t s = in_band ? live.slot(id) : IdMap::kMissing;
       if (s != IdMap::kMissing) live.flags[s] |= LiveMesh::kInBand;
       ids_.push_back(id);
       growable_.push_back(s != IdMap::kMissing);
       frame.append(p, local_);
+      return at;
     };
     {
       const TilePoints own = source_.load_border(tile, reach.context);
@@ -100,39 +104,36 @@ class SeamStitcher {
         continue;
       }
       const auto [root, parity] = live.groups.find(live.group[t]);
-      Triangle ids{live.id[tri[0]], live.id[tri[1]], live.id[tri[2]]};
-      if (parity) std::swap(ids[1], ids[2]);
-      preload_.push_back(ids);
+      Triangle corners{};  // places in ids_ for now
+      for (int k = 0; k < 3; ++k) {
+        const Index s = tri[k];
+        corners[k] = take(live.id[s], (live.flags[s] & LiveMesh::kInBand) != 0,
+                          &live.xyz[3 * std::size_t{s}]);
+      }
+      if (parity) std::swap(corners[1], corners[2]);
+      preload_.push_back(corners);
       preload_group_.push_back(root);
       preload_live_.push_back(static_cast<std::uint32_t>(t));
-      for (Index s : tri) {
-        take(live.id[s], (live.flags[s] & LiveMesh::kInBand) != 0, &live.xyz[3 * std::size_t{s}]);
-      }
     }
     for (std::size_t k = 0; k < ids_.size(); ++k) {
       if (growable_[k]) live.flags[live.slot(ids_[k])] &= ~LiveMesh::kInBand;
     }
 
     const HashGrid grid(local_, ids_);
-    // Global id -> grid index for the preloaded corners (the grid keeps the smallest id of exact
-    // duplicates, as every tile's grid does, so all kept corners are in it).
-    std::vector<std::pair<Index, std::uint32_t>> index(grid.size());
-    for (std::uint32_t k = 0; k < grid.size(); ++k) index[k] = {grid.id(k), k};
-    std::sort(index.begin(), index.end());
-    auto grid_index = [&](Index id) {
-      const auto at = std::lower_bound(index.begin(), index.end(), std::pair{id, 0u});
-      if (at == index.end() || at->first != id) {
-        throw Error(Exit::failure, "seam stitcher: a kept corner is missing from the seam grid");
-      }
-      return at->second;
-    };
+    // Place in ids_ -> grid index, for the preloaded corners (the grid keeps the smallest id of
+    // exact duplicates, as every tile's grid does, so all kept corners are in it).
+    grid_of_.assign(ids_.size(), kNoIndex);
+    for (std::uint32_t k = 0; k < grid.size(); ++k) grid_of_[grid.source(k)] = k;
     for (Triangle& t : preload_) {
-      for (Index& v : t) v = grid_index(v);
+      for (Index& v : t) {
+        v = grid_of_[v];
+        if (v == kNoIndex) {
+          throw Error(Exit::failure, "seam stitcher: a kept corner is missing from the seam grid");
+        }
+      }
     }
     std::vector<std::uint8_t> growable(grid.size());
-    for (std::uint32_t k = 0; k < grid.size(); ++k) {
-      growable[k] = growable_[local_of_.find(grid.id(k))];
-    }
+    for (std::uint32_t k = 0; k < grid.size(); ++k) growable[k] = growable_[grid.source(k)];
 
     vote_orientation(grid, growable);
 
@@ -283,6 +284,7 @@ class SeamStitcher {
   std::vector<Index> ids_;
   std::vector<float> local_;
   std::vector<std::uint8_t> growable_;
+  std::vector<std::uint32_t> grid_of_;  // per point of ids_: its index in the seam grid
   std::vector<Triangle> preload_;
   std::vector<std::uint32_t> preload_group_;
   std::vector<std::uint32_t> preload_live_;  // per preloaded triangle: its place in the live mesh
