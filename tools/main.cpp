@@ -1,15 +1,48 @@
 // g2s: the command-line tool. A thin layer over include/g2s/: parse, call, report.
 #include <fmt/core.h>
 #include <malloc.h>
+#include <unistd.h>
 
+#include <cstdlib>
+#include <cstring>
 #include <exception>
+#include <string>
 
 #include "cli_checks.hpp"
 #include "commands.hpp"
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
 
+namespace {
+
+// Page faults are a large part of a run on a virtual machine: about 10 us each on the 2-vCPU
+// VM, where meshing the 5M-point torus on one thread took 365k of them. With glibc's
+// transparent huge pages for malloc's memory (the tunable glibc.malloc.hugetlb=1, which glibc
+// reads only at start-up) it took 14k and 25% less time (bench/results/2026-11-28-session21.md).
+// So the tool starts itself once more with the tunable added, unless GLIBC_TUNABLES already
+// names it (glibc.malloc.hugetlb=0 keeps it off), or valgrind runs it (its preload library is
+// in LD_PRELOAD: valgrind does not follow the restart). Where it cannot (no /proc), it goes on.
+void restart_with_huge_pages(char** argv) {
+  constexpr const char* kTunable = "glibc.malloc.hugetlb";
+  const char* tunables = std::getenv("GLIBC_TUNABLES");
+  if (tunables != nullptr && std::strstr(tunables, kTunable) != nullptr) return;
+  const char* preload = std::getenv("LD_PRELOAD");
+  if (preload != nullptr && std::strstr(preload, "vgpreload") != nullptr) return;
+  const std::string before = tunables != nullptr ? tunables : "";
+  const std::string value = (before.empty() ? "" : before + ":") + kTunable + "=1";
+  if (setenv("GLIBC_TUNABLES", value.c_str(), 1) != 0) return;
+  execv("/proc/self/exe", argv);
+  if (tunables != nullptr) {
+    setenv("GLIBC_TUNABLES", before.c_str(), 1);
+  } else {
+    unsetenv("GLIBC_TUNABLES");
+  }
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  restart_with_huge_pages(argv);
   CLI::App app{
       "g2s: fast manifold surface reconstruction of point clouds (G2S mesh growing).\n\n"
       "Exit codes: 0 success; 1 internal error; 2 bad command line; 3 bad input (missing,\n"
