@@ -12,6 +12,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -374,3 +375,34 @@ TEST_F(HostileCli, SignalDuringTheSummaryKeepsTheCompleteFileAndSaysSo) {
 }
 
 }  // namespace
+
+// The tool starts itself once more with glibc's huge pages for malloc (tools/main.cpp): the
+// restarted run must get the same arguments and give the same bytes as a run without them, and
+// a user's own tunables must survive it.
+TEST_F(HostileCli, HugePagesChangeNoByte) {
+  const fs::path in = cloud("t.ply", "torus", "40000");
+  const char* had = std::getenv("GLIBC_TUNABLES");
+  const std::string before = had != nullptr ? had : "";
+  const auto mesh = [&](const char* tunables, const std::string& name) {
+    if (tunables != nullptr) {
+      setenv("GLIBC_TUNABLES", tunables, 1);
+    } else {
+      unsetenv("GLIBC_TUNABLES");
+    }
+    const CliRun r = run({"mesh", in.string(), "-o", path(name).string(), "--json"});
+    EXPECT_EQ(r.code, kOk) << r.err;
+    EXPECT_NE(r.out.find("\"triangles\":"), std::string::npos) << r.out;
+    return file_bytes(path(name));
+  };
+  const std::string with = mesh(nullptr, "with.stl");
+  const std::string without = mesh("glibc.malloc.hugetlb=0", "without.stl");
+  const std::string other = mesh("glibc.malloc.tcache_count=0", "other.stl");
+  if (had != nullptr) {
+    setenv("GLIBC_TUNABLES", before.c_str(), 1);
+  } else {
+    unsetenv("GLIBC_TUNABLES");
+  }
+  EXPECT_FALSE(with.empty());
+  EXPECT_EQ(with, without);
+  EXPECT_EQ(with, other);
+}
