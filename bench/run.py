@@ -149,8 +149,15 @@ def machine():
     for line in Path("/proc/meminfo").read_text().splitlines():
         if line.startswith("MemTotal:"):
             ram_kb = int(line.split()[1])
+    # g2s runs with glibc's huge pages for malloc (docs/pipeline.md, "Memory"): they count only
+    # where the kernel's mode (the bracketed word) is not "never", or unless the run's
+    # GLIBC_TUNABLES turns them off, so both go with the figures.
+    thp = Path("/sys/kernel/mm/transparent_hugepage/enabled")
+    text = thp.read_text() if thp.exists() else ""
+    huge_pages = text.split("[", 1)[1].split("]", 1)[0] if "[" in text else "unknown"
     return {"arch": platform.machine(), "cpu": cpu, "cores": os.cpu_count(),
-            "ram_mb": round(ram_kb / 1024), "kernel": platform.release()}
+            "ram_mb": round(ram_kb / 1024), "kernel": platform.release(),
+            "transparent_hugepage": huge_pages, "glibc_tunables": os.environ.get("GLIBC_TUNABLES", "")}
 
 
 def git(*args):
