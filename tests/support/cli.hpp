@@ -43,6 +43,32 @@ struct CliOptions {
   std::vector<std::string> prefix;
 };
 
+// A copy of the CLI that user nobody can run, made once per test process and removed at its
+// end: the build folder may be out of nobody's reach (a checkout under /root, mode 0700).
+class NobodyCli {
+ public:
+  NobodyCli() : folder_("g2s-cli") {
+    namespace fs = std::filesystem;
+    constexpr fs::perms kOpen = fs::perms::owner_all | fs::perms::group_read |
+                                fs::perms::group_exec | fs::perms::others_read |
+                                fs::perms::others_exec;
+    fs::permissions(folder_.path(), kOpen);
+    path_ = (folder_.path() / "g2s").string();
+    fs::copy_file(G2S_CLI_PATH, path_);
+    fs::permissions(path_, kOpen);
+  }
+  const std::string& path() const { return path_; }
+
+ private:
+  TempFolder folder_;
+  std::string path_;
+};
+
+inline const std::string& nobody_cli_path() {
+  static const NobodyCli cli;
+  return cli.path();
+}
+
 // `g2s ARGS` started in a child process whose working folder is `dir`. Its stdout and stderr go
 // to unnamed temporary files, so the folder holds only what g2s writes there.
 //
@@ -64,7 +90,8 @@ class CliChild {
       }
     }
     for (const std::string& a : options.prefix) argv.push_back(const_cast<char*>(a.c_str()));
-    for (const char* a : {"/usr/bin/timeout", "--foreground", "0", G2S_CLI_PATH}) {
+    const char* cli = options.as_nobody ? nobody_cli_path().c_str() : G2S_CLI_PATH;
+    for (const char* a : {"/usr/bin/timeout", "--foreground", "0", cli}) {
       argv.push_back(const_cast<char*>(a));
     }
     for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
