@@ -134,6 +134,17 @@ struct LiveMesh {
     __builtin_prefetch(&xyz[3 * std::size_t{s}]);
   }
 
+  // Starts loading what free_slot(s) will read: the slot's flags, uses and id, or (with those
+  // loaded) the map entry it erases.
+  void prefetch_slot(std::uint32_t s) const {
+    __builtin_prefetch(&flags[s]);
+    __builtin_prefetch(&uses[s]);
+    __builtin_prefetch(&id[s]);
+  }
+  void prefetch_map_entry(std::uint32_t s) const {
+    if (!(flags[s] & kUnlisted)) slot_of.prefetch(id[s]);
+  }
+
   // Forgets a released point no live triangle uses.
   void free_slot(std::uint32_t s) {
     if (!(flags[s] & kUnlisted)) slot_of.erase(id[s]);

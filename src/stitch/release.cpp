@@ -100,16 +100,10 @@ void release_finished(LiveMesh& live, std::size_t step, const Vec3& origin, Mesh
     return (live.flags[s] & LiveMesh::kReleased) && live.uses[s] == 0;
   };
   for (std::size_t k = 0; k < maybe_free.size(); ++k) {
-    // The slot's flags, uses and id two steps ahead, then the map entry its id hashes to.
-    if (k + 2 * kAhead < maybe_free.size()) {
-      const std::uint32_t s = maybe_free[k + 2 * kAhead];
-      __builtin_prefetch(&live.flags[s]);
-      __builtin_prefetch(&live.uses[s]);
-      __builtin_prefetch(&live.id[s]);
-    }
-    if (k + kAhead < maybe_free.size()) {
-      const std::uint32_t s = maybe_free[k + kAhead];
-      if (may_free(s) && !(live.flags[s] & LiveMesh::kUnlisted)) live.slot_of.prefetch(live.id[s]);
+    // The slot two steps ahead, then the map entry of one that will be freed.
+    if (k + 2 * kAhead < maybe_free.size()) live.prefetch_slot(maybe_free[k + 2 * kAhead]);
+    if (k + kAhead < maybe_free.size() && may_free(maybe_free[k + kAhead])) {
+      live.prefetch_map_entry(maybe_free[k + kAhead]);
     }
     const std::uint32_t s = maybe_free[k];
     if (may_free(s)) {

@@ -374,11 +374,9 @@ TEST_F(HostileCli, SignalDuringTheSummaryKeepsTheCompleteFileAndSaysSo) {
   EXPECT_GT(g2s::read_mesh(out).triangles.size(), 500000u);
 }
 
-}  // namespace
-
 // The tool starts itself once more with glibc's huge pages for malloc (tools/main.cpp): the
-// restarted run must get the same arguments and give the same bytes as a run without them, and
-// a user's own tunables must survive it.
+// restarted run must get the same arguments and give the same bytes as a run without them, also
+// when the user's GLIBC_TUNABLES names other tunables (which the restart appends to).
 TEST_F(HostileCli, HugePagesChangeNoByte) {
   const fs::path in = cloud("t.ply", "torus", "40000");
   const char* had = std::getenv("GLIBC_TUNABLES");
@@ -406,3 +404,5 @@ TEST_F(HostileCli, HugePagesChangeNoByte) {
   EXPECT_EQ(with, without);
   EXPECT_EQ(with, other);
 }
+
+}  // namespace
