@@ -48,7 +48,8 @@ inline double triangle_area(const Vec3f& a, const Vec3f& b, const Vec3f& c) {
 // loop[n-1]-loop[0]), facing as the filling will; chord_ok(i, j), for loop positions i < j that
 // are not neighbours on the loop, whether the edge loop[i]-loop[j] may be made (false where the
 // mesh has that edge already); triangle_ok(i, k, j), whether the triangle on loop positions
-// i < k < j may be made (asked once per triangle, after the cheaper conditions); scratch space.
+// i < k < j may be made (asked at most once per triangle, after the cheaper conditions, and only
+// about a triangle that would be chosen: see below); scratch space.
 // Output: appends loop.size() - 2 triangles to `out` and returns the cosine of their sharpest
 // fold (between two of them or with `around`), or returns nothing (out unchanged) when every
 // triangulation needs a forbidden chord, a forbidden triangle or a degenerate one. The sharpest
@@ -58,6 +59,11 @@ inline double triangle_area(const Vec3f& a, const Vec3f& b, const Vec3f& c) {
 // fold cannot win), O(n^3) scratch: loops are short (the grower's limit is max_hole_edges).
 // Every triangulation has a triangle on each loop edge, so a loop with an edge that no allowed
 // triangle uses is given up first, after O(n^2) questions to triangle_ok instead of O(n^3).
+// Then the states are built without asking triangle_ok; a state is asked about only when a
+// parent's search (or the whole loop's) would take it as its best so far, and passed over if
+// refused. A refused state that no search would take cannot change any choice, so the result is
+// the one asking every state would give, after far fewer questions (on a corner of alpe, 243k
+// instead of 326k calls to the grower's crossing test).
 template <class ChordOk, class TriangleOk>
 std::optional<double> triangulate_loop(std::span<const Vec3f> points, std::span<const Index> loop,
                                        std::span<const Vec3> around, ChordOk&& chord_ok,
@@ -73,7 +79,7 @@ std::optional<double> triangulate_loop(std::span<const Vec3f> points, std::span<
   scratch.count.assign(n * n, 0);
   scratch.verdict.assign(n * n * n, 0);
   // Whether triangle (i, k, j), i < k < j, may be made: its chords, its area, then triangle_ok
-  // (asked once).
+  // (asked once; the verdict is kept).
   const auto is_edge = [&](std::size_t a, std::size_t b) {
     return b == a + 1 || (a == 0 && b == n - 1);
   };
@@ -123,7 +129,7 @@ std::optional<double> triangulate_loop(std::span<const Vec3f> points, std::span<
       const State& s = state(a, b, c);
       if (s.fold_cos < best.fold_cos) break;  // nor can any after it
       const double fold_cos = std::min(s.fold_cos, dot(normal, s.normal));
-      if (better(fold_cos, s.area, best.fold_cos, best.area)) {
+      if (better(fold_cos, s.area, best.fold_cos, best.area) && allowed(a, c, b)) {
         best = Side{fold_cos, s.area, static_cast<std::uint16_t>(c)};
       }
     }
@@ -141,7 +147,7 @@ std::optional<double> triangulate_loop(std::span<const Vec3f> points, std::span<
         if (!(twice_area > 0)) continue;
         const Vec3 normal = w * (1 / twice_area);
         const Side left = side(i, k, normal), right = side(k, j, normal);
-        if (left.fold_cos == kNone || right.fold_cos == kNone || !allowed(i, k, j)) continue;
+        if (left.fold_cos == kNone || right.fold_cos == kNone) continue;
         state(i, j, k) =
             State{std::min(left.fold_cos, right.fold_cos),
                   left.area + right.area + 0.5 * twice_area, normal, left.apex, right.apex};
@@ -162,7 +168,7 @@ std::optional<double> triangulate_loop(std::span<const Vec3f> points, std::span<
     const std::size_t k = scratch.by_fold[(n - 1) * n + r];
     const State& s = state(0, n - 1, k);
     const double fold_cos = std::min(s.fold_cos, dot(s.normal, around[n - 1]));
-    if (better(fold_cos, s.area, best_cos, best_area))
+    if (better(fold_cos, s.area, best_cos, best_area) && allowed(0, k, n - 1))
       best_cos = fold_cos, best_area = s.area, top = k;
   }
   if (best_cos == kNone) return std::nullopt;

@@ -1,8 +1,9 @@
 // The triangulation of a hole's loop (src/grow/hole_filling.hpp) on loops whose answers are
 // known: a planar convex loop gives n - 2 triangles covering exactly its area, all facing one
 // way; on bent loops its sharpest fold is the gentlest of all triangulations', as an
-// exhaustive search finds it; forbidden chords are never used; a loop that can only be closed
-// with forbidden chords, or only with degenerate triangles, is left open.
+// exhaustive search finds it, with or without triangles refused; forbidden chords are never used; a
+// loop that can only be closed with forbidden chords, or only with degenerate triangles, is left
+// open.
 #include "grow/hole_filling.hpp"
 
 #include <gtest/gtest.h>
@@ -176,7 +177,11 @@ void all_triangulations(std::size_t i, std::size_t j, std::vector<std::vector<Tr
   }
 }
 
-TEST(HoleFilling, BentLoopsGetTheGentlestFillingAsAnExhaustiveSearchFindsIt) {
+// Bent loops against an exhaustive search over every triangulation, with every triangle allowed
+// or (refuse) about one in four refused by triangle_ok: the filling's sharpest fold is the
+// gentlest of the allowed triangulations', it uses no refused triangle, and the loop stays open
+// exactly when no triangulation avoids them.
+void check_against_exhaustive_search(bool refuse) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> jitter(-0.4f, 0.4f);
   for (int trial = 0; trial < 40; ++trial) {
@@ -213,8 +218,17 @@ TEST(HoleFilling, BentLoopsGetTheGentlestFillingAsAnExhaustiveSearchFindsIt) {
       }
       return fold_cos;
     };
+    std::vector<std::uint8_t> refused(static_cast<std::size_t>(n * n * n), 0);
+    for (std::uint8_t& r : refused) r = refuse && rng() % 4 == 0;
+    const auto is_refused = [&](const Triangle& t) {  // corners i < k < j
+      return refused[(t[0] * static_cast<std::size_t>(n) + t[1]) * static_cast<std::size_t>(n) +
+                     t[2]] != 0;
+    };
     std::vector<std::vector<Triangle>> every;
     all_triangulations(0, static_cast<std::size_t>(n - 1), every);
+    std::erase_if(every, [&](const std::vector<Triangle>& fill) {
+      return std::any_of(fill.begin(), fill.end(), is_refused);
+    });
     double best_cos = -2;
     for (const auto& fill : every) {
       double area = 0;
@@ -229,15 +243,33 @@ TEST(HoleFilling, BentLoopsGetTheGentlestFillingAsAnExhaustiveSearchFindsIt) {
     }
     detail::HoleScratch scratch;
     std::vector<Triangle> out;
+    std::size_t asked = 0;
+    const auto allowed = [&](std::size_t i, std::size_t k, std::size_t j) {
+      ++asked;
+      return !is_refused({static_cast<Index>(i), static_cast<Index>(k), static_cast<Index>(j)});
+    };
     const auto fold_cos = detail::triangulate_loop(
-        points, loop, around, [](std::size_t, std::size_t) { return true; }, any_triangle, scratch,
-        out);
-    ASSERT_TRUE(fold_cos);
+        points, loop, around, [](std::size_t, std::size_t) { return true; }, allowed, scratch, out);
+    EXPECT_LE(asked, static_cast<std::size_t>(n * (n - 1) * (n - 2) / 6)) << "trial " << trial;
+    ASSERT_EQ(fold_cos.has_value(), !every.empty()) << "trial " << trial;
+    if (!fold_cos) continue;
+    for (Triangle t : out) {
+      std::sort(t.begin(), t.end());
+      EXPECT_FALSE(is_refused(t)) << "trial " << trial;
+    }
     double area = 0;
     EXPECT_NEAR(judge(out, area), best_cos, 1e-9) << "trial " << trial;
     EXPECT_NEAR(*fold_cos, best_cos, 1e-9) << "trial " << trial;
     EXPECT_LE(area, worst_area_at_best) << "trial " << trial;
   }
+}
+
+TEST(HoleFilling, BentLoopsGetTheGentlestFillingAsAnExhaustiveSearchFindsIt) {
+  check_against_exhaustive_search(/*refuse=*/false);
+}
+
+TEST(HoleFilling, RefusedTrianglesLeaveTheGentlestAllowedFilling) {
+  check_against_exhaustive_search(/*refuse=*/true);
 }
 
 }  // namespace
