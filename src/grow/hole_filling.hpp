@@ -34,8 +34,9 @@ struct HoleScratch {
   std::vector<std::uint16_t> by_fold;
   std::vector<std::uint16_t> count;
   std::vector<std::size_t> stack;
-  // Per triangle (i, k, j), i < k < j: 0 not yet asked, 1 allowed, 2 not.
+  // Per triangle (i, k, j), i < k < j: kUnasked, kAllowed or kRefused.
   std::vector<std::uint8_t> verdict;
+  static constexpr std::uint8_t kUnasked = 0, kAllowed = 1, kRefused = 2;
 };
 
 inline double triangle_area(const Vec3f& a, const Vec3f& b, const Vec3f& c) {
@@ -85,15 +86,15 @@ std::optional<double> triangulate_loop(std::span<const Vec3f> points, std::span<
   };
   const auto allowed = [&](std::size_t i, std::size_t k, std::size_t j) {
     std::uint8_t& verdict = scratch.verdict[(i * n + k) * n + j];
-    if (verdict == 0) {
+    if (verdict == HoleScratch::kUnasked) {
       const Vec3 p = Vec3(points[loop[i]]);
       const bool ok = (is_edge(i, k) || chord_ok(i, k)) && (is_edge(k, j) || chord_ok(k, j)) &&
                       (is_edge(i, j) || chord_ok(i, j)) &&
                       norm2(cross(Vec3(points[loop[k]]) - p, Vec3(points[loop[j]]) - p)) > 0 &&
                       triangle_ok(i, k, j);
-      verdict = ok ? 1 : 2;
+      verdict = ok ? HoleScratch::kAllowed : HoleScratch::kRefused;
     }
-    return verdict == 1;
+    return verdict == HoleScratch::kAllowed;
   };
   // Each loop edge a-b needs a triangle: the ears on it first (most often allowed), then the
   // rest.
@@ -122,18 +123,23 @@ std::optional<double> triangulate_loop(std::span<const Vec3f> points, std::span<
   };
   const auto side = [&](std::size_t a, std::size_t b, const Vec3& normal) {
     if (b == a + 1) return Side{dot(normal, around[a]), 0, 0};
-    Side best{kNone, 0, 0};
     const std::uint16_t* apexes = &scratch.by_fold[(a * n + b) * n];
-    for (std::size_t r = 0; r < scratch.count[a * n + b]; ++r) {
-      const std::size_t c = apexes[r];
-      const State& s = state(a, b, c);
-      if (s.fold_cos < best.fold_cos) break;  // nor can any after it
-      const double fold_cos = std::min(s.fold_cos, dot(normal, s.normal));
-      if (better(fold_cos, s.area, best.fold_cos, best.area) && allowed(a, c, b)) {
-        best = Side{fold_cos, s.area, static_cast<std::uint16_t>(c)};
+    // The best apex among those not refused, and only then whether its triangle may be made:
+    // a refused winner is passed over and the search runs again.
+    for (;;) {
+      Side best{kNone, 0, 0};
+      for (std::size_t r = 0; r < scratch.count[a * n + b]; ++r) {
+        const std::size_t c = apexes[r];
+        const State& s = state(a, b, c);
+        if (s.fold_cos < best.fold_cos) break;  // nor can any after it
+        if (scratch.verdict[(a * n + c) * n + b] == HoleScratch::kRefused) continue;
+        const double fold_cos = std::min(s.fold_cos, dot(normal, s.normal));
+        if (better(fold_cos, s.area, best.fold_cos, best.area)) {
+          best = Side{fold_cos, s.area, static_cast<std::uint16_t>(c)};
+        }
       }
+      if (best.fold_cos == kNone || allowed(a, best.apex, b)) return best;
     }
-    return best;
   };
   for (std::size_t width = 2; width < n; ++width) {
     for (std::size_t i = 0; i + width < n; ++i) {
@@ -162,19 +168,11 @@ std::optional<double> triangulate_loop(std::span<const Vec3f> points, std::span<
     }
   }
   // The whole loop: chord 0-(n-1) is the closing loop edge.
-  double best_cos = kNone, best_area = 0;
-  std::size_t top = 0;
-  for (std::size_t r = 0; r < scratch.count[n - 1]; ++r) {
-    const std::size_t k = scratch.by_fold[(n - 1) * n + r];
-    const State& s = state(0, n - 1, k);
-    const double fold_cos = std::min(s.fold_cos, dot(s.normal, around[n - 1]));
-    if (better(fold_cos, s.area, best_cos, best_area) && allowed(0, k, n - 1))
-      best_cos = fold_cos, best_area = s.area, top = k;
-  }
-  if (best_cos == kNone) return std::nullopt;
+  const Side whole = side(0, n - 1, around[n - 1]);
+  if (whole.fold_cos == kNone) return std::nullopt;
   // Unwind the apexes: (i, k, j) is counter-clockwise along the loop's order.
   std::vector<std::size_t>& stack = scratch.stack;
-  stack.assign({0, n - 1, top});
+  stack.assign({0, n - 1, whole.apex});
   while (!stack.empty()) {
     const std::size_t k = stack.back();
     stack.pop_back();
@@ -187,7 +185,7 @@ std::optional<double> triangulate_loop(std::span<const Vec3f> points, std::span<
     if (k > i + 1) stack.insert(stack.end(), {i, k, s.left});
     if (j > k + 1) stack.insert(stack.end(), {k, j, s.right});
   }
-  return best_cos;
+  return whole.fold_cos;
 }
 
 }  // namespace g2s::detail
