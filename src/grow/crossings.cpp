@@ -253,9 +253,8 @@ std::size_t TriangleCells::Level::find(std::uint64_t k) const {
 }
 
 void TriangleCells::build(Level& level, std::span<const std::uint32_t> members) {
-  const auto key_of = [&](std::uint32_t t) {
-    const Vec3f lo = box_of(points_, triangles_[t]).lo;
-    return key(level.coord(lo.x), level.coord(lo.y), level.coord(lo.z));
+  const auto key_of = [&](const Box& box) {
+    return key(level.coord(box.lo.x), level.coord(box.lo.y), level.coord(box.lo.z));
   };
   const auto home = [&](std::uint64_t k) {
     return static_cast<std::size_t>((k * 0x9E3779B97F4A7C15ull) >> level.shift);
@@ -271,7 +270,7 @@ void TriangleCells::build(Level& level, std::span<const std::uint32_t> members) 
     return s;
   };
   for (const std::uint32_t t : members) {
-    const std::uint64_t k = key_of(t);
+    const std::uint64_t k = key_of(box_of(points_, triangles_[t]));
     std::size_t s = slot_for(k);
     if (level.keys[s] == kEmpty) {
       if (2 * (cells + 1) > level.keys.size()) {
@@ -306,9 +305,10 @@ void TriangleCells::build(Level& level, std::span<const std::uint32_t> members) 
   level.filed.resize(members.size());
   level.boxes.resize(members.size());
   for (const std::uint32_t t : members) {
-    const std::uint32_t at = level.end[level.find(key_of(t))]++;
+    const Box box = box_of(points_, triangles_[t]);
+    const std::uint32_t at = level.end[level.find(key_of(box))]++;
     level.filed[at] = t;
-    level.boxes[at] = box_of(points_, triangles_[t]);
+    level.boxes[at] = box;
   }
 }
 
