@@ -17,6 +17,7 @@
 #include "cli_checks.hpp"
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
+#include "g2s/sink_behind.hpp"
 #include "g2s/stats.hpp"
 #include "g2s/stream_stats.hpp"
 #include "g2s/surface_check.hpp"
@@ -220,7 +221,10 @@ void write_and_report(const TileSource& source,
   StreamStats counter(timed, rounded, !rounded || all_float);
   const auto mesh_start = std::chrono::steady_clock::now();
   const double mesh_cpu = cpu_seconds();
-  const PipelineSummary summary = args.no_stats ? run(timed) : run(static_cast<MeshSink&>(counter));
+  // The triangles the stitcher releases one by one are counted and encoded on a thread of
+  // their own (SinkBehind), off the serial stitch stage.
+  SinkBehind behind(args.no_stats ? static_cast<MeshSink&>(timed) : counter);
+  const PipelineSummary summary = run(behind);
   const StageTime mesh{seconds_since(mesh_start), cpu_seconds() - mesh_cpu};
   if (summary.triangles == 0) throw_no_triangle(source, summary, facts);
   if (facts.output_written) facts.output_written();
@@ -290,6 +294,7 @@ void write_and_report(const TileSource& source,
             .raw("grow_and_stitch", stage({mesh.wall - timed.time.wall, mesh.cpu - timed.time.cpu}))
             .raw("grow", JsonObject().fixed("cpu", summary.cpu_seconds_grow, 3).str())
             .raw("stitch", JsonObject().fixed("cpu", summary.cpu_seconds_stitch, 3).str())
+            .raw("sink", JsonObject().fixed("cpu", behind.cpu_seconds(), 3).str())
             .raw("write", JsonObject().fixed("cpu", writer.write_cpu_seconds(), 3).str())
             .raw("output", stage(timed.time))
             .raw("summary", JsonObject()
