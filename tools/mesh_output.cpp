@@ -8,11 +8,13 @@
 #include <fmt/core.h>
 #include <signal.h>
 #include <sys/stat.h>
+#include <tbb/task_arena.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "cli_checks.hpp"
 #include "g2s/error.hpp"
@@ -31,6 +33,12 @@ namespace {
 // stats' edge map): `g2s stats` on the 20M-triangle torus STL peaked at 1.70 GB (85 bytes a
 // triangle); twice that leaves room for meshes with more vertices per triangle.
 constexpr std::uint64_t kStatsBytesPerTriangle = 160;
+
+// Threads from which the sink gets a thread of its own (SinkBehind). Growth takes 7 to 16 times
+// the serial stitch stage's CPU on the runs measured (the 20M torus, alpe, raw-bunny), so the
+// stitcher starts to bound a run from about 8 threads; below, the thread would cost its heap
+// (the count's tables, 12 MB on table-mug) and save no time.
+constexpr int kSinkThreadFrom = 8;
 
 // Passes everything on and times the sink's finish (the output's last pass: flipped groups
 // rewritten, the file renamed into place).
@@ -221,10 +229,14 @@ void write_and_report(const TileSource& source,
   StreamStats counter(timed, rounded, !rounded || all_float);
   const auto mesh_start = std::chrono::steady_clock::now();
   const double mesh_cpu = cpu_seconds();
-  // The triangles the stitcher releases one by one are counted and encoded on a thread of
-  // their own (SinkBehind), off the serial stitch stage.
-  SinkBehind behind(args.no_stats ? static_cast<MeshSink&>(timed) : counter);
-  const PipelineSummary summary = run(behind);
+  // With many threads, the triangles the stitcher releases one by one are counted and encoded
+  // on a thread of their own (SinkBehind), off the serial stitch stage, which then bounds the
+  // run less. With few, growth bounds the run and the thread would only cost memory: the
+  // count's tables would sit in that thread's own heap, apart from what the run frees.
+  MeshSink& counted = args.no_stats ? static_cast<MeshSink&>(timed) : counter;
+  std::optional<SinkBehind> behind;
+  if (tbb::this_task_arena::max_concurrency() >= kSinkThreadFrom) behind.emplace(counted);
+  const PipelineSummary summary = run(behind ? static_cast<MeshSink&>(*behind) : counted);
   const StageTime mesh{seconds_since(mesh_start), cpu_seconds() - mesh_cpu};
   if (summary.triangles == 0) throw_no_triangle(source, summary, facts);
   if (facts.output_written) facts.output_written();
@@ -294,7 +306,7 @@ void write_and_report(const TileSource& source,
             .raw("grow_and_stitch", stage({mesh.wall - timed.time.wall, mesh.cpu - timed.time.cpu}))
             .raw("grow", JsonObject().fixed("cpu", summary.cpu_seconds_grow, 3).str())
             .raw("stitch", JsonObject().fixed("cpu", summary.cpu_seconds_stitch, 3).str())
-            .raw("sink", JsonObject().fixed("cpu", behind.cpu_seconds(), 3).str())
+            .raw("sink", JsonObject().fixed("cpu", behind ? behind->cpu_seconds() : 0.0, 3).str())
             .raw("write", JsonObject().fixed("cpu", writer.write_cpu_seconds(), 3).str())
             .raw("output", stage(timed.time))
             .raw("summary", JsonObject()

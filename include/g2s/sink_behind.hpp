@@ -1,17 +1,18 @@
 // A sink that takes the stitcher's triangles one at a time (MeshSink::vertex, triangle,
-// vertex_done) on a thread of its own. In `g2s mesh` the sink is the defect count (StreamStats)
-// in front of the writer, and the triangles that leave the live mesh one by one reach it from
-// the serial stitch stage: on the 20M-point torus, counting and encoding them was about a third
-// of that stage's CPU. Here the stitch stage only copies each call into a batch, and full
-// batches are played to the next sink on the other thread, in order, so the next sink sees the
-// very calls it would have seen, one at a time. block() and finish() wait until every batch is
-// played, then go to the next sink from the caller's thread; prepare() goes straight through
-// (it may run beside the other calls anyway).
+// vertex_done) on a thread of its own. In `g2s mesh` (from 8 threads) the sink is the defect count
+// (StreamStats) in front of the writer, and the triangles that leave the live mesh one by one reach
+// it from the serial stitch stage: on the 20M-point torus, counting and encoding them was about a
+// third of that stage's CPU. Here the stitch stage only copies each call into a batch, and full
+// batches are played to the next sink on the other thread, in order, so the next sink sees the very
+// calls it would have seen, one at a time. block() and finish() wait until every batch is played,
+// then go to the next sink from the caller's thread; prepare() goes straight through (it may run
+// beside the other calls anyway).
 //
-// Inputs: next, the sink to play the calls to. Outputs: the same calls to next, in the same
-// order, never two at once. An exception thrown by next on the other thread is thrown again
-// from the next call that hands over a batch, from block() or from finish(); after it, no more
-// calls reach next. Memory: two batches of kBatchCalls calls, under 1 MB.
+// Inputs: next, the sink to play the calls to. Outputs: the same calls to next, in the same order,
+// never two at once. An exception thrown by next on the other thread is thrown again from the next
+// call that hands over a batch, from block() or from finish(); after it, no more calls reach next.
+// Memory: two batches of kBatchCalls calls, under 1 MB.
+
 #pragma once
 
 #include <atomic>

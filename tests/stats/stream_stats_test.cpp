@@ -472,6 +472,33 @@ TEST_F(MeshSummary, CountedInStrideAsGStatsCountsTheFile) {
   }
 }
 
+// From 8 threads the sink gets a thread of its own (SinkBehind): the file and every count are
+// the same as with 2 threads, where it has none, and the JSON reports the thread's CPU.
+TEST_F(MeshSummary, TheSinksOwnThreadChangesNoByteNorCount) {
+  const fs::path cloud = g2s::test_support::data_dir() / "raw-bunny.ply";
+  G2S_SKIP_WITHOUT_DATA(cloud);
+  const auto sink_cpu = [](const std::string& json) {
+    const std::size_t at = json.find("\"sink\":");
+    return at == std::string::npos ? -1.0 : json_number(json.substr(at), "cpu");
+  };
+  for (const char* extension : {".stl", ".ply"}) {
+    std::string summary[2], bytes[2];
+    const char* threads[2] = {"2", "8"};
+    for (int k = 0; k < 2; ++k) {
+      const fs::path mesh = dir_ / (std::string("mesh-") + threads[k] + extension);
+      summary[k] = run({"mesh", cloud.string(), "-o", mesh.string(), "--tile-points", "20000",
+                        "--threads", threads[k], "--json"});
+      std::ifstream in(mesh, std::ios::binary);
+      bytes[k].assign(std::istreambuf_iterator<char>(in), {});
+    }
+    EXPECT_FALSE(bytes[0].empty());
+    EXPECT_TRUE(bytes[0] == bytes[1]) << extension;
+    EXPECT_EQ(stats_object(summary[0]), stats_object(summary[1])) << extension;
+    EXPECT_EQ(sink_cpu(summary[0]), 0.0) << summary[0];
+    EXPECT_GT(sink_cpu(summary[1]), 0.0) << summary[1];
+  }
+}
+
 // The peak memory `g2s mesh` reports is the process's peak as the kernel measures it
 // (/usr/bin/time), summary included: counted in stride (the counter's own peak, reported apart,
 // is part of it) or read back (STL far from the origin, whose float rounding may weld vertices
