@@ -3,6 +3,8 @@
 // the mesh written with a summary of its defects. `g2s tile`, `g2s grow` and `g2s stitch` run the
 // same stages as separate processes and give the same bytes.
 #include <fmt/core.h>
+#include <tbb/global_control.h>
+#include <tbb/info.h>
 #include <tbb/task_arena.h>
 #include <unistd.h>
 
@@ -11,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <string_view>
 
 #include "cli_checks.hpp"
@@ -250,7 +253,13 @@ void add_mesh_command(CLI::App& app) {
   add_mesh_options(*cmd, args->options);
   // Every stage in one arena of --threads threads: the tiling and the output keep to the count
   // too (a shared node's allocation), and the pipeline needs no arena of its own (mesh_tiles).
+  // More threads than cores are allowed as asked: TBB would otherwise keep to the cores and warn.
   cmd->callback([args] {
+    std::optional<tbb::global_control> allow;
+    if (args->threads > tbb::info::default_concurrency()) {
+      allow.emplace(tbb::global_control::max_allowed_parallelism,
+                    static_cast<std::size_t>(args->threads));
+    }
     tbb::task_arena(args->threads > 0 ? args->threads : tbb::task_arena::automatic).execute([&] {
       run_mesh(*args);
     });
