@@ -15,17 +15,16 @@
 
 #pragma once
 
-#include <atomic>
-#include <condition_variable>
 #include <cstdint>
 #include <exception>
-#include <mutex>
-#include <thread>
+#include <memory>
 #include <vector>
 
 #include "g2s/mesh_sink.hpp"
 
 namespace g2s {
+
+class JobThread;
 
 class SinkBehind final : public MeshSink {
  public:
@@ -44,7 +43,7 @@ class SinkBehind final : public MeshSink {
   void finish(std::span<const std::uint8_t> flip) override;
 
   // CPU seconds the playing thread has used.
-  double cpu_seconds() const { return 1e-9 * static_cast<double>(cpu_ns_.load()); }
+  double cpu_seconds() const;
 
   static constexpr std::size_t kBatchCalls = 4096;
 
@@ -59,18 +58,13 @@ class SinkBehind final : public MeshSink {
   };
   void hand_over();  // the filling batch to the thread, once it is free
   void wait_idle();  // until every batch handed over is played; throws what next threw
-  void run();
+  void play();       // playing_ to next, on the thread
 
   MeshSink& next_;
   std::vector<Call> filling_;
-  std::mutex mutex_;
-  std::condition_variable changed_;
-  std::vector<Call> playing_;  // being played while busy_, else the spare
-  bool busy_ = false;
-  bool stop_ = false;
+  std::vector<Call> playing_;  // being played while a job is in flight, else the spare
   std::exception_ptr error_;
-  std::atomic<std::uint64_t> cpu_ns_{0};
-  std::thread thread_;
+  std::unique_ptr<JobThread> thread_;  // last: it ends before the batches go
 };
 
 }  // namespace g2s

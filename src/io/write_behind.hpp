@@ -6,13 +6,11 @@
 // given with it (pwrite), so the file position plays no part.
 #pragma once
 
-#include <atomic>
-#include <condition_variable>
 #include <cstddef>
 #include <cstdint>
-#include <mutex>
-#include <thread>
 #include <vector>
+
+#include "common/job_thread.hpp"
 
 namespace g2s {
 
@@ -21,7 +19,7 @@ class WriteBehind {
   // Inputs: an open file, and the capacity of the buffers the caller fills (the spare one is
   // reserved to it, so handing buffers back and forth never reallocates).
   WriteBehind(int fd, std::size_t capacity);
-  ~WriteBehind();  // waits for the write in flight; its error, if any, is dropped
+  ~WriteBehind() = default;  // waits for the write in flight; its error, if any, is dropped
   WriteBehind(const WriteBehind&) = delete;
   WriteBehind& operator=(const WriteBehind&) = delete;
 
@@ -33,21 +31,16 @@ class WriteBehind {
   // write that failed.
   int wait();
   // CPU seconds the writing thread has used.
-  double cpu_seconds() const { return 1e-9 * static_cast<double>(cpu_ns_.load()); }
+  double cpu_seconds() const { return thread_.cpu_seconds(); }
 
  private:
-  void run();
+  void write();  // pending_ at offset_, on the thread
 
   int fd_;
-  std::mutex mutex_;
-  std::condition_variable changed_;
-  std::vector<char> pending_;  // being written while busy_, else the spare
+  std::vector<char> pending_;  // being written while a job is in flight, else the spare
   std::uint64_t offset_ = 0;
-  bool busy_ = false;
-  bool stop_ = false;
   int error_ = 0;
-  std::atomic<std::uint64_t> cpu_ns_{0};
-  std::thread thread_;
+  JobThread thread_;  // last: it ends before the buffers go
 };
 
 }  // namespace g2s

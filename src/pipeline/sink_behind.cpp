@@ -1,26 +1,22 @@
-// SinkBehind (g2s/sink_behind.hpp): one thread, one batch in flight, handed over under a mutex,
-// as io/write_behind does with buffers.
+// SinkBehind (g2s/sink_behind.hpp): each full batch is one job of a JobThread, as the output's
+// buffers are in io/write_behind.
 #include "g2s/sink_behind.hpp"
-
-#include <time.h>
 
 #include <algorithm>
 
+#include "common/job_thread.hpp"
+
 namespace g2s {
 
-SinkBehind::SinkBehind(MeshSink& next) : next_(next) {
+SinkBehind::SinkBehind(MeshSink& next) : next_(next), thread_(std::make_unique<JobThread>()) {
   filling_.reserve(kBatchCalls);
   playing_.reserve(kBatchCalls);
-  thread_ = std::thread([this] { run(); });
 }
 
-SinkBehind::~SinkBehind() {
-  {
-    const std::lock_guard lock(mutex_);
-    stop_ = true;
-  }
-  changed_.notify_all();
-  thread_.join();
+SinkBehind::~SinkBehind() = default;
+
+double SinkBehind::cpu_seconds() const {
+  return thread_->cpu_seconds();
 }
 
 void SinkBehind::vertex(Index id, const double xyz[3]) {
@@ -66,58 +62,43 @@ void SinkBehind::finish(std::span<const std::uint8_t> flip) {
 }
 
 void SinkBehind::hand_over() {
-  std::unique_lock lock(mutex_);
-  changed_.wait(lock, [&] { return !busy_; });
-  if (error_) std::rethrow_exception(error_);
-  if (filling_.empty()) return;
-  playing_.swap(filling_);
-  filling_.clear();
-  busy_ = true;
-  lock.unlock();
-  changed_.notify_all();
+  std::exception_ptr error;  // read while no batch is in flight
+  thread_->start(
+      [&] {
+        error = error_;
+        if (error || filling_.empty()) return false;
+        playing_.swap(filling_);
+        filling_.clear();
+        return true;
+      },
+      [this] { play(); });
+  if (error) std::rethrow_exception(error);
 }
 
 void SinkBehind::wait_idle() {
-  std::unique_lock lock(mutex_);
-  changed_.wait(lock, [&] { return !busy_; });
+  thread_->wait();
   if (error_) std::rethrow_exception(error_);
 }
 
-void SinkBehind::run() {
-  std::unique_lock lock(mutex_);
-  for (;;) {
-    changed_.wait(lock, [&] { return busy_ || stop_; });
-    if (!busy_) return;
-    lock.unlock();
-    // The caller touches playing_ only while !busy_.
-    std::exception_ptr error;
-    try {
-      for (const Call& call : playing_) {
-        switch (call.kind) {
-          case Call::Kind::vertex:
-            next_.vertex(call.number, call.xyz);
-            break;
-          case Call::Kind::triangle:
-            next_.triangle(call.corners, {call.xyz, call.xyz + 3, call.xyz + 6}, call.number);
-            break;
-          case Call::Kind::vertex_done:
-            next_.vertex_done(call.number);
-            break;
-        }
+void SinkBehind::play() {
+  try {
+    for (const Call& call : playing_) {
+      switch (call.kind) {
+        case Call::Kind::vertex:
+          next_.vertex(call.number, call.xyz);
+          break;
+        case Call::Kind::triangle:
+          next_.triangle(call.corners, {call.xyz, call.xyz + 3, call.xyz + 6}, call.number);
+          break;
+        case Call::Kind::vertex_done:
+          next_.vertex_done(call.number);
+          break;
       }
-    } catch (...) {
-      error = std::current_exception();
     }
-    playing_.clear();
-    timespec cpu{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &cpu);
-    cpu_ns_ = static_cast<std::uint64_t>(cpu.tv_sec) * 1000000000u +
-              static_cast<std::uint64_t>(cpu.tv_nsec);
-    lock.lock();
-    if (!error_) error_ = error;
-    busy_ = false;
-    changed_.notify_all();
+  } catch (...) {
+    error_ = std::current_exception();  // the owner reads it only while no batch is in flight
   }
+  playing_.clear();
 }
 
 }  // namespace g2s
