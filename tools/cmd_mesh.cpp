@@ -113,6 +113,7 @@ void run_mesh(MeshArgs& args) {
   }
   const std::uint64_t budget = args.memory > 0 ? args.memory : default_memory_budget();
   const MemoryPlan plan = plan_memory(budget, args.threads);
+  fit_heap_to_budget(budget);
   args.out.memory = budget;
   const std::uint64_t tile_points = args.tile_points > 0 ? args.tile_points : plan.tile_points;
   try {

@@ -3,6 +3,8 @@
 #include <malloc.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <exception>
@@ -41,6 +43,27 @@ void restart_with_huge_pages(char** argv) {
 
 }  // namespace
 
+namespace g2s::cli {
+
+// A fixed threshold: glibc's own raises it as blocks are freed and keeps a fragmented heap that
+// grows with the run (+60% peak RSS at 40M points). At 1 MiB every tile-sized array was a fresh
+// mapping, and its page faults (expensive on virtual machines) took a quarter of the run; at
+// 32 MiB a tile's arrays are reused from the heap: 20-33% less wall time, peak +6-30%
+// (bench/results/2026-11-27-heap-threshold.md). The same bound on the free space kept at the top
+// of each heap: at glibc's 128 KiB, a freed tile's arrays went back to the kernel and came back
+// as page faults for the next tile (15-28% less wall time on the shared scans). But each of the
+// run's 3-4 heaps may then keep 32 MiB free, about 100 MB that a small budget does not have
+// (alpe under --memory 256M peaked at 364-418 MB, 324-328 MB with either threshold at 4 MiB,
+// bench/results/2026-11-28-session23.md): so at most a 64th of the budget.
+void fit_heap_to_budget(std::uint64_t budget_bytes) {
+  const auto threshold =
+      static_cast<int>(std::clamp<std::uint64_t>(budget_bytes / 64, 128 << 10, 32 << 20));
+  mallopt(M_MMAP_THRESHOLD, threshold);
+  mallopt(M_TRIM_THRESHOLD, threshold);
+}
+
+}  // namespace g2s::cli
+
 int main(int argc, char** argv) {
   restart_with_huge_pages(argv);
   CLI::App app{
@@ -50,16 +73,7 @@ int main(int argc, char** argv) {
       "folder, disk full); 5 no surface: the points cannot form one (none usable, all the same,\n"
       "two distinct, all on one line, too sparse), nothing written; 130 interrupted."};
   g2s::install_interrupt_cleanup();
-  // A fixed threshold: glibc's own raises it as blocks are freed and keeps a fragmented heap
-  // that grows with the run (+60% peak RSS at 40M points). At 1 MiB every tile-sized array was
-  // a fresh mapping, and its page faults (expensive on virtual machines) took a quarter of the
-  // run; at 32 MiB a tile's arrays are reused from the heap: 20-33% less wall time, peak +6-30%,
-  // still well under --memory (bench/results/2026-11-27-heap-threshold.md). The same bound on
-  // the free space kept at the top of each heap: at glibc's 128 KiB, a freed tile's arrays went
-  // back to the kernel and came back as page faults for the next tile (a quarter of the page
-  // faults' cost again: 15-28% less wall time on the shared scans).
-  mallopt(M_MMAP_THRESHOLD, 32 << 20);
-  mallopt(M_TRIM_THRESHOLD, 32 << 20);
+  g2s::cli::fit_heap_to_budget(std::uint64_t{1} << 40);
   app.require_subcommand(1);
   app.failure_message(g2s::cli::failure_message);
   app.set_version_flag("--version", "g2s 0.1.0");
