@@ -112,13 +112,13 @@ void run_mesh(MeshArgs& args) {
     run.temporary_store = store_path.string();
   }
   const std::uint64_t budget = args.memory > 0 ? args.memory : default_memory_budget();
-  const MemoryPlan plan = plan_memory(budget, args.threads);
+  MemoryPlan plan = plan_memory(budget, args.threads);
   fit_heap_to_budget(budget);
   args.out.memory = budget;
-  const std::uint64_t tile_points = args.tile_points > 0 ? args.tile_points : plan.tile_points;
+  std::uint64_t tile_points = args.tile_points > 0 ? args.tile_points : plan.tile_points;
   try {
     ReadReport read;
-    if (temporary || !reusable(store_path, args.input, tile_points, args.out.quiet)) {
+    const auto cut = [&] {
       TileStoreOptions tiling;
       tiling.tile_points = tile_points;
       if (args.tile_points == 0) tiling.min_tiles = plan.min_tiles;
@@ -131,8 +131,37 @@ void run_mesh(MeshArgs& args) {
       const auto start = std::chrono::steady_clock::now();
       const double cpu = cpu_seconds();
       read = build_tile_store(args.input, store_path, tiling).read;
-      run.tile = {std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
-                  cpu_seconds() - cpu};
+      run.tile.wall +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      run.tile.cpu += cpu_seconds() - cpu;
+    };
+    if (temporary || !reusable(store_path, args.input, tile_points, args.out.quiet)) cut();
+    // Under a budget that bounds the tile, the band of open seams is predicted from the tiles as
+    // cut and reserved; while tiles and band do not fit, the cloud is cut again with smaller
+    // tiles (at most twice: smaller tiles lengthen the seams, so the band is predicted again).
+    // All of it depends on the input and the budget only, so the mesh does on nothing else.
+    for (int cuts = 0; args.tile_points == 0 && plan.tile_bound_by_budget; ++cuts) {
+      std::uint64_t live = 0, largest = 0;
+      {
+        const TileStore cut_store(store_path);
+        live = predict_peak_live_points(cut_store, args.options);
+        for (const TileInfo& t : cut_store.tiles()) largest = std::max(largest, t.points);
+      }
+      if (budget < least_memory(live)) {
+        if (!args.out.quiet) {
+          fmt::print(stderr,
+                     "g2s: warning: {}: --memory {} MB cannot hold the band of open seams (about "
+                     "{} points held at once; {} MB would, with the smallest tiles): the peak "
+                     "may exceed it\n",
+                     args.input, budget >> 20, live, (least_memory(live) >> 20) + 1);
+        }
+        break;
+      }
+      const MemoryPlan fitted = plan_memory(budget, args.threads, live);
+      plan.tiles_in_flight = fitted.tiles_in_flight;
+      if (largest <= fitted.tile_points || cuts == 2) break;
+      tile_points = fitted.tile_points;
+      cut();
     }
     const TileStore store(store_path);
     if (read.format.empty()) read = store.input_report();

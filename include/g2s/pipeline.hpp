@@ -59,15 +59,19 @@ PipelineMesh mesh_cloud(const PointCloud& cloud, const PipelineOptions& options 
 
 // How `g2s mesh --memory` spends a budget of bytes (peak resident memory, as /usr/bin/time -v
 // reports it): the largest tile, the tiles grown and waiting at once, and the points the tile
-// store's writer sorts per round. Per-point costs measured on the synthetic torus, with the
-// margin docs/pipeline.md gives; a budget too small for a workable tile throws Error(usage).
+// store's writer sorts per round. Per-point costs measured on the synthetic torus and alpe, with
+// the margin docs/pipeline.md gives. live_points: the points the stitcher will hold at once
+// along its open seams (predict_peak_live_points, include/g2s/tile_stages.hpp), reserved before
+// the tiles; 0 when not known yet. A budget below least_memory(live_points) throws Error(usage).
 struct MemoryPlan {
   std::uint64_t tile_points = 0;
   std::uint64_t min_tiles = 1;  // TileStoreOptions::min_tiles: at least this many tiles
   std::size_t tiles_in_flight = 0;
   std::uint64_t round_points = 0;
+  bool tile_bound_by_budget = false;  // tile_points is below the default tile for lack of memory
 };
-MemoryPlan plan_memory(std::uint64_t budget_bytes, int threads);
+MemoryPlan plan_memory(std::uint64_t budget_bytes, int threads, std::uint64_t live_points = 0);
+std::uint64_t least_memory(std::uint64_t live_points);
 
 // The default budget: half of the machine's physical memory.
 std::uint64_t default_memory_budget();

@@ -121,4 +121,12 @@ class Stitcher {
   std::unique_ptr<Impl> impl_;
 };
 
+// The most points the Stitcher will hold at once over `source`'s tiles (PipelineSummary's
+// peak_live_points, before any tile grows): each point a seam may look up, from its tile's step
+// through the step that releases it, as Stitcher::prepare decides; the few points held only as
+// corners of triangles not yet final, or as possible second fans, are not counted. Reads every
+// tile once, in parallel. g2s mesh sizes its tiles by it under a tight --memory
+// (docs/pipeline.md, "Memory").
+std::uint64_t predict_peak_live_points(const TileSource& source, const PipelineOptions& options);
+
 }  // namespace g2s

@@ -2,7 +2,9 @@
 // thread growing a tile (its points, halo, hash grid, front and triangles), each tile grown and
 // waiting for the stitcher (its points and kept triangles), and the stitcher taking in a tile
 // (a live slot per point until the tile's interior is released). What does not: the band of
-// open seams, a few tens of spacings wide, small next to any tile. The split below is an
+// open seams, a few tens of spacings wide, which grows with the cloud's extent and with its
+// noise; when the budget bounds the tile, g2s mesh predicts it from the tiles as cut
+// (predict_peak_live_points) and plans again with it reserved. The split below is an
 // estimate: what was measured (/usr/bin/time -v) is a whole single-thread run of one 450k-point
 // tile, 120 MB (about 270 bytes a point), and the resulting peaks, 262-286 MB for tori of 10M
 // and 40M points under 512M (docs/benchmarks.md, "Memory"): the constants are conservative.
@@ -21,8 +23,19 @@ namespace {
 constexpr double kGrowBytesPerPoint = 400;     // a tile being grown, with its halo
 constexpr double kWaitingBytesPerPoint = 100;  // a grown tile waiting to be stitched
 constexpr double kStitchBytesPerPoint = 150;   // the tile being stitched and released
-constexpr double kFixedBytes = 40e6;           // code, TBB, buffers, the live band
-constexpr double kStoreBytesPerPoint = 64;     // the tile store writer, per point of a round
+constexpr double kFixedBytes = 20e6;  // code, libraries, TBB, buffers: a tiny cloud's whole run
+// What the allocator may keep free for reuse: g2s mesh bounds each heap's two thresholds by a
+// 64th of the budget and 32 MiB, and a run has 3-4 heaps (fit_heap_to_budget, tools/main.cpp):
+// an eighth of the budget, at most 256 MiB.
+constexpr double kMostRetained = 8 * 32.0 * 1048576;
+double heap_retention(double budget) {
+  return std::min(budget / 8, kMostRetained);
+}
+// A point the stitcher holds along the open seams: its live slot, id map entry and triangles,
+// and its record in the defect count (heaptrack on alpe under --memory 128M: about 90 MB of heap
+// at 389k live points, 231 bytes each; docs/pipeline.md "Memory").
+constexpr double kLiveBytesPerPoint = 256;
+constexpr double kStoreBytesPerPoint = 64;  // the tile store writer, per point of a round
 // The largest default tile, when the budget allows it (docs/pipeline.md, "Tile size"): larger
 // tiles save no time, and on photogrammetry each seam costs a few tenths of a second of serial
 // stitching.
@@ -34,31 +47,43 @@ constexpr std::uint64_t kMinTiles = 4;
 // Tiles growing at once that the tile size is planned for (more when the budget holds them).
 constexpr double kPlannedGrowers = 2;
 constexpr std::uint64_t kSmallestTile = 4096;
+constexpr double kPlannedBytesPerPoint =
+    kPlannedGrowers * kGrowBytesPerPoint + kWaitingBytesPerPoint + kStitchBytesPerPoint;
 
 }  // namespace
 
-MemoryPlan plan_memory(std::uint64_t budget_bytes, int threads) {
+std::uint64_t least_memory(std::uint64_t live_points) {
+  const double needed = kFixedBytes + kLiveBytesPerPoint * static_cast<double>(live_points) +
+                        kPlannedBytesPerPoint * kSmallestTile;
+  // The least budget b with b - heap_retention(b) = needed.
+  const double budget = needed <= 7 * kMostRetained ? needed * 8 / 7 : needed + kMostRetained;
+  return static_cast<std::uint64_t>(budget) + 1;
+}
+
+MemoryPlan plan_memory(std::uint64_t budget_bytes, int threads, std::uint64_t live_points) {
   const auto workers = static_cast<std::size_t>(
       threads > 0 ? threads : std::max(1, tbb::info::default_concurrency()));
   // The tile size is sized for kPlannedGrowers tiles growing at once whatever --threads says, so
   // that the tiles, and with them the mesh, are the same for any thread count; the threads then
   // get as many tiles in flight as the budget holds at that size.
-  const double usable = static_cast<double>(budget_bytes) - kFixedBytes;
-  const double planned_per_point =
-      kPlannedGrowers * kGrowBytesPerPoint + kWaitingBytesPerPoint + kStitchBytesPerPoint;
-  const double tile = usable / planned_per_point;
-  if (!(tile >= static_cast<double>(kSmallestTile))) {
+  const auto budget = static_cast<double>(budget_bytes);
+  const double usable = budget - heap_retention(budget) - kFixedBytes -
+                        kLiveBytesPerPoint * static_cast<double>(live_points);
+  const double tile = usable / kPlannedBytesPerPoint;
+  if (budget_bytes < least_memory(live_points)) {
     throw Error(Exit::usage,
-                fmt::format("--memory {} MB is too small: at least {:.0f} MB", budget_bytes >> 20,
-                            (kFixedBytes + planned_per_point * kSmallestTile) / 1048576.0 + 1));
+                fmt::format("--memory {} MB is too small: at least {} MB", budget_bytes >> 20,
+                            (least_memory(live_points) >> 20) + 1));
   }
   MemoryPlan plan;
-  plan.tile_points = std::min(kDefaultTile, static_cast<std::uint64_t>(tile));
+  plan.tile_points = std::clamp(static_cast<std::uint64_t>(tile), kSmallestTile, kDefaultTile);
+  plan.tile_bound_by_budget = plan.tile_points < kDefaultTile;
   plan.min_tiles = kMinTiles;
   const double tile_size = static_cast<double>(plan.tile_points);
   const double growers =
       (usable / tile_size - kWaitingBytesPerPoint - kStitchBytesPerPoint) / kGrowBytesPerPoint;
-  const std::size_t growing = std::min(workers, static_cast<std::size_t>(growers));
+  const std::size_t growing =
+      std::clamp(static_cast<std::size_t>(std::max(growers, 1.0)), std::size_t{1}, workers);
   // Grown tiles wait for the stitcher, which takes them in order: while one slow tile grows,
   // the other threads go on only as far as tiles may wait. As many may wait as threads grow,
   // when the budget holds them (at least one): a timeline of alpe (13 tiles of 84k-757k points,

@@ -15,6 +15,9 @@
 // stitcher joins the groups meeting at a seam with the parity their normals vote for (where the
 // vote is clear; others as it connects them), and the end flips each group so that all of a
 // component faces one way, and the component outward as the in-memory mesher does.
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -295,31 +298,36 @@ class SeamStitcher {
   std::vector<GrowContext::Link> links_;
 };
 
-}  // namespace
+// When the seams are done with a point: per tile, the seams' reach and the faces other tiles lie
+// beyond, measured as the stitcher measures (Stitcher::prepare) and as peak_live_points
+// predicts.
+struct SeamSteps {
+  SeamSteps(std::span<const TileInfo> all, const PipelineOptions& options) : tiles(all) {
+    for (std::size_t t = 0; t < all.size(); ++t) {
+      reach.push_back(seam_reach(all, t, options));
+      faces.push_back(tile_faces(all, t));
+    }
+  }
 
-struct Stitcher::Impl {
-  Impl(const TileSource& s, const PipelineOptions& o, MeshSink& k)
-      : source(s), options(o), sink(k), stitcher(s, options), live(s.tiles().size()) {}
-  // Read by prepare() on other threads while add() runs: set once, and kept off the cache lines
-  // that add() writes, so the threads do not pass those lines back and forth.
-  const TileSource& source;
-  const PipelineOptions options;  // a copy: callers may pass a temporary
-  MeshSink& sink;
-  std::vector<SeamReach> reach;  // per tile
-  std::vector<TileFaces> faces;  // per tile
-  Vec3 origin{0, 0, 0};
-  alignas(64) SeamStitcher stitcher;
-  LiveMesh live;
-  ReleaseCounts released;
-  PipelineSummary out;
-  std::size_t next = 0;  // the tile add() expects
+  // The later tiles whose seams can reach into `tile`'s box, increasing, and the largest reach
+  // and margin among them.
+  void later_near(std::size_t tile, std::vector<std::size_t>& later, double& inside) const {
+    later.clear();
+    inside = 0;
+    for (std::size_t j = tile + 1; j < tiles.size(); ++j) {
+      const double far = reach[j].touch + reach[j].margin;
+      if (tiles[j].points > 0 && box_gap(tiles[tile].box, tiles[j].box) <= far) {
+        later.push_back(j);
+        inside = std::max(inside, far);
+      }
+    }
+  }
 
   // The last step whose seam can touch a point of `tile` at p: the largest later tile within
   // its reach; with `margin`, within its reach and its margin (the release step).
-  // `later`: the candidates, increasing; `inside`: the largest reach and margin among them.
+  // `later` and `inside`: from later_near.
   std::uint32_t last_step(std::size_t tile, const double* p, std::span<const std::size_t> later,
                           double inside, bool margin) const {
-    const std::span<const TileInfo> tiles = source.tiles();
     // Every other box lies beyond an open face: a point deeper than any reach is done.
     if (faces[tile].depth(p) > inside) return static_cast<std::uint32_t>(tile);
     for (std::size_t k = later.size(); k-- > 0;) {
@@ -330,6 +338,41 @@ struct Stitcher::Impl {
     }
     return static_cast<std::uint32_t>(tile);
   }
+
+  // Whether the live mesh holds a point of `tile` released at step `release`: a seam may look
+  // it up (a later seam reaches it, or it lies within its own tile's reach and margin of an
+  // open face).
+  bool listed(std::size_t tile, const double* p, std::uint32_t release) const {
+    return release != tile || faces[tile].depth(p) <= reach[tile].touch + reach[tile].margin;
+  }
+
+  std::span<const TileInfo> tiles;
+  std::vector<SeamReach> reach;  // per tile
+  std::vector<TileFaces> faces;  // per tile
+};
+
+}  // namespace
+
+struct Stitcher::Impl {
+  Impl(const TileSource& s, const PipelineOptions& o, MeshSink& k)
+      : source(s),
+        options(o),
+        sink(k),
+        steps(s.tiles(), options),
+        stitcher(s, options),
+        live(s.tiles().size()) {}
+  // Read by prepare() on other threads while add() runs: set once, and kept off the cache lines
+  // that add() writes, so the threads do not pass those lines back and forth.
+  const TileSource& source;
+  const PipelineOptions options;  // a copy: callers may pass a temporary
+  MeshSink& sink;
+  SeamSteps steps;
+  Vec3 origin{0, 0, 0};
+  alignas(64) SeamStitcher stitcher;
+  LiveMesh live;
+  ReleaseCounts released;
+  PipelineSummary out;
+  std::size_t next = 0;  // the tile add() expects
 };
 
 Stitcher::Stitcher(const TileSource& source, const PipelineOptions& options, MeshSink& sink) {
@@ -339,10 +382,6 @@ Stitcher::Stitcher(const TileSource& source, const PipelineOptions& options, Mes
   impl_ = std::make_unique<Impl>(source, options, sink);
   const std::span<const TileInfo> tiles = source.tiles();
   impl_->out.tiles = tiles.size();
-  for (std::size_t t = 0; t < tiles.size(); ++t) {
-    impl_->reach.push_back(seam_reach(tiles, t, options));
-    impl_->faces.push_back(tile_faces(tiles, t));
-  }
   const TileBox bounds = tiles_bounds(tiles);
   impl_->origin = {0.5 * (bounds.lo[0] + bounds.hi[0]), 0.5 * (bounds.lo[1] + bounds.hi[1]),
                    0.5 * (bounds.lo[2] + bounds.hi[2])};
@@ -421,26 +460,17 @@ PreparedTile Stitcher::prepare(std::size_t tile, TileGrowth growth) const {
   for (Index v : growth.second_fans) held_at[v] = 0;
   std::vector<std::size_t> later;
   double inside = 0;
-  for (std::size_t j = tile + 1; j < tiles.size(); ++j) {
-    const double far = m.reach[j].touch + m.reach[j].margin;
-    if (tiles[j].points > 0 && box_gap(tiles[tile].box, tiles[j].box) <= far) {
-      later.push_back(j);
-      inside = std::max(inside, far);
-    }
-  }
-  // Deeper than this, a point is out of reach of this tile's seams, even as the far corner of a
-  // live triangle touching the band (the longest edge: the margin).
-  const double unreachable = m.reach[tile].touch + m.reach[tile].margin;
+  m.steps.later_near(tile, later, inside);
   // Each point's release step, and whether a seam can look it up, known before the final
   // triangles go out: a point only they use is announced done to the sink right after its last
   // one (a sink counting defects in stride then holds few points open).
   for (std::size_t k = 0; k < n; ++k) {
     const double* p = &points.xyz[3 * k];
-    const std::uint32_t release = m.last_step(tile, p, later, inside, true);
-    const bool listed = release != tile || m.faces[tile].depth(p) <= unreachable;
+    const std::uint32_t release = m.steps.last_step(tile, p, later, inside, true);
+    const bool listed = m.steps.listed(tile, p, release);
     if (!listed && held_at[k] == kNoIndex) continue;
     const std::uint32_t finish =
-        release == tile ? release : m.last_step(tile, p, later, inside, false);
+        release == tile ? release : m.steps.last_step(tile, p, later, inside, false);
     held_at[k] = static_cast<std::uint32_t>(d.held.size());
     d.held.push_back({{p[0], p[1], p[2]}, points.ids[k], finish, release, kNoIndex, listed});
   }
@@ -525,7 +555,7 @@ void Stitcher::add(std::size_t tile, PreparedTile prepared) {
   r.non_manifold_vertices_fixed += growth.report.non_manifold_vertices_fixed;
   r.spacing = std::max(r.spacing, growth.report.spacing);
   prepared = PreparedTile{};
-  const auto [added, dropped] = m.stitcher.stitch(tile, m.reach[tile], live);
+  const auto [added, dropped] = m.stitcher.stitch(tile, m.steps.reach[tile], live);
   m.out.triangles_stitched += added;
   m.out.seam_triangles_dropped += dropped;
   r.triangles_grown += added;
@@ -552,6 +582,49 @@ PipelineSummary Stitcher::finish() {
       group_flips(m.live.groups, m.live.sums, m.options.mesh.orient, out.report.components_flipped);
   m.sink.finish(flip);
   return out;
+}
+
+std::uint64_t predict_peak_live_points(const TileSource& source, const PipelineOptions& options) {
+  const std::span<const TileInfo> tiles = source.tiles();
+  const SeamSteps steps(tiles, options);
+  // Per tile: how many of its held points each step releases (index 0: the tile's own step,
+  // k > 0: its k-th later tile within reach).
+  std::vector<std::vector<std::uint64_t>> released(tiles.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tiles.size(), 1),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      std::vector<std::size_t> later;
+                      double inside = 0;
+                      for (std::size_t t = range.begin(); t < range.end(); ++t) {
+                        if (tiles[t].points == 0) continue;
+                        steps.later_near(t, later, inside);
+                        std::vector<std::uint64_t>& count = released[t];
+                        count.assign(later.size() + 1, 0);
+                        const TilePoints points = source.load(t);
+                        for (std::size_t k = 0; k < points.size(); ++k) {
+                          const double* p = &points.xyz[3 * k];
+                          const std::uint32_t step = steps.last_step(t, p, later, inside, true);
+                          if (!steps.listed(t, p, step)) continue;
+                          const auto at = std::find(later.begin(), later.end(), step);
+                          ++count[at == later.end() ? 0 : 1 + (at - later.begin())];
+                        }
+                      }
+                    });
+  // Points held from their tile's step through their release step.
+  std::vector<std::int64_t> change(tiles.size() + 1, 0);
+  std::vector<std::size_t> later;
+  double inside = 0;
+  for (std::size_t t = 0; t < tiles.size(); ++t) {
+    if (released[t].empty()) continue;
+    steps.later_near(t, later, inside);
+    for (std::size_t k = 0; k < released[t].size(); ++k) {
+      const std::size_t last = k == 0 ? t : later[k - 1];
+      change[t] += static_cast<std::int64_t>(released[t][k]);
+      change[last + 1] -= static_cast<std::int64_t>(released[t][k]);
+    }
+  }
+  std::int64_t held = 0, peak = 0;
+  for (const std::int64_t c : change) peak = std::max(peak, held += c);
+  return static_cast<std::uint64_t>(peak);
 }
 
 }  // namespace g2s
