@@ -63,8 +63,10 @@ bool reusable(const std::filesystem::path& store, const std::filesystem::path& i
     const TileStore kept(store);
     if (kept.origin() == store_origin(input, tile_points)) return true;
     why = kept.origin().tile_points != tile_points
-              ? fmt::format("was cut with --tile-points {}, not {}", kept.origin().tile_points,
-                            tile_points)
+              ? fmt::format(
+                    "was cut into tiles of at most {} points, not {} (--tile-points, "
+                    "--memory)",
+                    kept.origin().tile_points, tile_points)
               : fmt::format("was made from another file or version of {}", input.string());
   } catch (const Error& e) {
     if (e.code() != Exit::bad_input) throw;
@@ -115,7 +117,8 @@ void run_mesh(MeshArgs& args) {
   MemoryPlan plan = plan_memory(budget, args.threads);
   fit_heap_to_budget(budget);
   args.out.memory = budget;
-  std::uint64_t tile_points = args.tile_points > 0 ? args.tile_points : plan.tile_points;
+  const std::uint64_t planned_tile = args.tile_points > 0 ? args.tile_points : plan.tile_points;
+  std::uint64_t tile_points = planned_tile;
   try {
     ReadReport read;
     const auto cut = [&] {
@@ -135,11 +138,13 @@ void run_mesh(MeshArgs& args) {
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       run.tile.cpu += cpu_seconds() - cpu;
     };
-    if (temporary || !reusable(store_path, args.input, tile_points, args.out.quiet)) cut();
+    if (temporary || !reusable(store_path, args.input, planned_tile, args.out.quiet)) cut();
     // Under a budget that bounds the tile, the band of open seams is predicted from the tiles as
     // cut and reserved; while tiles and band do not fit, the cloud is cut again with smaller
     // tiles (at most twice: smaller tiles lengthen the seams, so the band is predicted again).
-    // All of it depends on the input and the budget only, so the mesh does on nothing else.
+    // All of it depends on the input and the budget only, so the mesh does on nothing else; a
+    // kept store is reused only as first cut (a store cut again records its own tile, so the
+    // next run starts over from the first cut, as a fresh one does).
     for (int cuts = 0; args.tile_points == 0 && plan.tile_bound_by_budget; ++cuts) {
       std::uint64_t live = 0, largest = 0;
       {

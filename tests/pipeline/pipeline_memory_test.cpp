@@ -182,6 +182,24 @@ TEST_F(PipelineMemory, ABandTheBudgetCannotHoldIsWarnedAbout) {
   EXPECT_EQ(stderr_text().find("cannot hold"), std::string::npos) << stderr_text();
 }
 
+// Cut again for its band, a kept store records the tile it was cut with, not the one the budget
+// planned: the next run with the same budget starts over from the first cut, as a fresh run
+// does, and gives the same bytes (reusing the last cut would predict its band afresh and might
+// cut again, another mesh).
+TEST_F(PipelineMemory, AStoreCutAgainForItsBandGivesTheBytesOfAFreshRun) {
+  const std::filesystem::path scan = g2s::test_support::data_dir() / "raw-bunny.ply";
+  G2S_SKIP_WITHOUT_DATA(scan);
+  for (const char* out : {"kept1.ply", "kept2.ply"}) {
+    ASSERT_EQ(run({"mesh", scan.string(), "-o", out, "--memory", "48M", "--keep-store", "k.store"}),
+              0)
+        << stderr_text();
+  }
+  ASSERT_EQ(run({"mesh", scan.string(), "-o", "fresh.ply", "--memory", "48M"}), 0);
+  const std::string fresh = g2s::test_support::file_bytes(dir_.path() / "fresh.ply");
+  EXPECT_TRUE(g2s::test_support::file_bytes(dir_.path() / "kept1.ply") == fresh);
+  EXPECT_TRUE(g2s::test_support::file_bytes(dir_.path() / "kept2.ply") == fresh);
+}
+
 TEST_F(PipelineMemory, ABudgetTooSmallIsRefused) {
   ASSERT_EQ(run({"synth", "sphere", "-n", "1000", "-o", "sphere.ply"}), 0);
   EXPECT_EQ(run({"mesh", "sphere.ply", "-o", "mesh.stl", "--memory", "8M", "--threads", "2"}), 2);
