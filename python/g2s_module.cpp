@@ -17,9 +17,11 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -205,21 +207,36 @@ py::dict mesh_file(const std::filesystem::path& input, const std::filesystem::pa
     store_path = temporary->path();
   }
   const std::uint64_t budget = budget_of(memory);
-  const g2s::MemoryPlan plan = g2s::plan_memory(budget, threads.value_or(0));
+  g2s::PipelineOptions options = pipeline_options(mesher, threads.value_or(0));
+  const std::uint64_t planned_tile =
+      tile_points > 0 ? tile_points : g2s::plan_memory(budget, options.threads).tile_points;
+  // A kept store made from this input for this plan is reused, as `g2s mesh --keep-store` does;
+  // a file there that is no tile store is refused rather than overwritten.
+  bool first_cut_made = false;
+  if (!temporary && std::filesystem::exists(store_path)) {
+    char magic[8] = {};
+    std::ifstream(store_path, std::ios::binary).read(magic, sizeof magic);
+    if (std::string_view(magic, sizeof magic) != "G2STILES") {
+      throw g2s::Error(g2s::Exit::usage, "keep_store " + store_path.string() +
+                                             ": the file there is not a g2s tile store; refusing "
+                                             "to overwrite it");
+    }
+    try {
+      first_cut_made =
+          g2s::TileStore(store_path).origin() == g2s::store_origin(input, planned_tile);
+    } catch (const g2s::Error& e) {
+      if (e.code() != g2s::Exit::bad_input) throw;  // another version or damaged: cut afresh
+    }
+  }
+  // Cut as g2s mesh cuts for the same budget: the same tiles, so the same mesh.
   g2s::TileStoreOptions tiling;
-  tiling.tile_points = tile_points > 0 ? tile_points : plan.tile_points;
-  tiling.round_points = std::max(plan.round_points, tiling.tile_points);
+  tiling.tile_points = tile_points;
   tiling.compress = compress;
-  // A kept store newer than the input is reused, as `g2s mesh --keep-store` does.
-  std::error_code store_error, input_error;
-  const auto store_time = std::filesystem::last_write_time(store_path, store_error);
-  const auto input_time = std::filesystem::last_write_time(input, input_error);
-  const bool reuse = !temporary && !store_error && !input_error && store_time >= input_time;
-  if (!reuse) g2s::build_tile_store(input, store_path, tiling);
+  const g2s::BudgetTiling tiled =
+      g2s::tile_for_budget(input, store_path, budget, options, tiling, first_cut_made);
   const g2s::TileStore store(store_path);
   const g2s::ReadReport& read = store.input_report();
-  g2s::PipelineOptions options = pipeline_options(mesher, threads.value_or(0));
-  options.tiles_in_flight = plan.tiles_in_flight;
+  options.tiles_in_flight = tiled.plan.tiles_in_flight;
   g2s::PipelineSummary summary;
   {
     g2s::MeshStreamWriter writer(output, g2s::mesh_format_for(output, ascii));

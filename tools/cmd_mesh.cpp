@@ -114,67 +114,46 @@ void run_mesh(MeshArgs& args) {
     run.temporary_store = store_path.string();
   }
   const std::uint64_t budget = args.memory > 0 ? args.memory : default_memory_budget();
-  MemoryPlan plan = plan_memory(budget, args.threads);
+  // Refuses a budget too small for any tile before anything is read.
+  const std::uint64_t planned_tile =
+      args.tile_points > 0 ? args.tile_points : plan_memory(budget, args.threads).tile_points;
   fit_heap_to_budget(budget);
   args.out.memory = budget;
-  const std::uint64_t planned_tile = args.tile_points > 0 ? args.tile_points : plan.tile_points;
-  std::uint64_t tile_points = planned_tile;
+  args.options.threads = args.threads;
   try {
-    ReadReport read;
-    const auto cut = [&] {
-      TileStoreOptions tiling;
-      tiling.tile_points = tile_points;
-      if (args.tile_points == 0) tiling.min_tiles = plan.min_tiles;
-      tiling.round_points = std::max(plan.round_points, tiling.tile_points);
-      tiling.compress = args.compress;
-      tiling.progress = [&](std::uint64_t done, std::uint64_t total) {
-        progress.stage("tiling",
-                       total ? static_cast<double>(done) / static_cast<double>(total) : 1);
-      };
-      const auto start = std::chrono::steady_clock::now();
-      const double cpu = cpu_seconds();
-      read = build_tile_store(args.input, store_path, tiling).read;
-      run.tile.wall +=
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      run.tile.cpu += cpu_seconds() - cpu;
+    TileStoreOptions tiling;
+    tiling.tile_points = args.tile_points;
+    tiling.compress = args.compress;
+    tiling.progress = [&](std::uint64_t done, std::uint64_t total) {
+      progress.stage("tiling", total ? static_cast<double>(done) / static_cast<double>(total) : 1);
     };
-    if (temporary || !reusable(store_path, args.input, planned_tile, args.out.quiet)) cut();
-    // Under a budget that bounds the tile, the band of open seams is predicted from the tiles as
-    // cut and reserved; while tiles and band do not fit, the cloud is cut again with smaller
-    // tiles (at most twice: smaller tiles lengthen the seams, so the band is predicted again).
-    // All of it depends on the input and the budget only, so the mesh does on nothing else; a
-    // kept store is reused only as first cut (a store cut again records its own tile, so the
-    // next run starts over from the first cut, as a fresh one does).
-    for (int cuts = 0; args.tile_points == 0 && plan.tile_bound_by_budget; ++cuts) {
-      std::uint64_t live = 0, largest = 0;
-      {
-        const TileStore cut_store(store_path);
-        live = predict_peak_live_points(cut_store, args.options);
-        for (const TileInfo& t : cut_store.tiles()) largest = std::max(largest, t.points);
-      }
-      if (budget < least_memory(live)) {
-        if (!args.out.quiet) {
-          fmt::print(stderr,
-                     "g2s: warning: {}: --memory {} MB cannot hold the band of open seams (about "
-                     "{} points held at once; {} MB would, with the smallest tiles): the peak "
-                     "may exceed it\n",
-                     args.input, budget >> 20, live, (least_memory(live) >> 20) + 1);
-        }
-        break;
-      }
-      const MemoryPlan fitted = plan_memory(budget, args.threads, live);
-      plan.tiles_in_flight = fitted.tiles_in_flight;
-      if (largest <= fitted.tile_points || cuts == 2) break;
-      tile_points = fitted.tile_points;
-      cut();
+    // A kept store is reused only as the first cut for this plan: a store cut again for its
+    // band records its own tile, so the next run starts over from the first cut, as a fresh
+    // one does, and gives the same bytes.
+    const bool first_cut_made =
+        !temporary && reusable(store_path, args.input, planned_tile, args.out.quiet);
+    const auto start = std::chrono::steady_clock::now();
+    const double cpu = cpu_seconds();
+    const BudgetTiling tiled =
+        tile_for_budget(args.input, store_path, budget, args.options, tiling, first_cut_made);
+    if (tiled.cuts > 0) {
+      run.tile = {std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+                  cpu_seconds() - cpu};
     }
+    if (tiled.band_needs > 0 && !args.out.quiet) {
+      fmt::print(stderr,
+                 "g2s: warning: {}: --memory {} MB cannot hold the band of open seams (about {} "
+                 "points held at once; {} MB would, with the smallest tiles): the peak may "
+                 "exceed it\n",
+                 args.input, budget >> 20, tiled.live_points, (tiled.band_needs >> 20) + 1);
+    }
+    ReadReport read = tiled.read;
     const TileStore store(store_path);
     if (read.format.empty()) read = store.input_report();
     run.non_finite = read.non_finite;
     run.ignored_bytes = read.ignored_bytes;
     if (!args.out.quiet) print_input_notes(args.input, read);
-    args.options.threads = args.threads;
-    args.options.tiles_in_flight = plan.tiles_in_flight;
+    args.options.tiles_in_flight = tiled.plan.tiles_in_flight;
     args.options.progress = [&](std::uint64_t done, std::uint64_t total) {
       progress.stage("meshing", static_cast<double>(done) / static_cast<double>(total));
     };

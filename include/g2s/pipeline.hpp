@@ -73,6 +73,28 @@ struct MemoryPlan {
 MemoryPlan plan_memory(std::uint64_t budget_bytes, int threads, std::uint64_t live_points = 0);
 std::uint64_t least_memory(std::uint64_t live_points);
 
+// Cuts `input` into the tile store at `store` for a memory budget, as g2s mesh does
+// (src/pipeline/budget_tiling.cpp): tiling.tile_points 0 takes the tile plan_memory plans (at
+// least plan.min_tiles tiles) and, when the budget bounds it, predicts the band of open seams
+// from the tiles as cut (predict_peak_live_points) and cuts again smaller while the largest tile
+// does not fit beside it (at most twice); a tile_points given is cut as given. first_cut_made:
+// the store at `store` is already the first cut (a kept store cut with plan.tile_points), so
+// only the band is checked. Outputs: the plan (its tiles_in_flight for the store as finally
+// cut; tile_points the tile first planned), the read report of the last cut (empty when none
+// was made), the band predicted (0 when not needed) and, when the budget cannot hold that band
+// even with the smallest tiles, the least budget that would (band_needs; the store is then left
+// as cut and the run may exceed the budget).
+struct BudgetTiling {
+  MemoryPlan plan;
+  ReadReport read;
+  int cuts = 0;
+  std::uint64_t live_points = 0;
+  std::uint64_t band_needs = 0;
+};
+BudgetTiling tile_for_budget(const std::filesystem::path& input, const std::filesystem::path& store,
+                             std::uint64_t budget_bytes, const PipelineOptions& options,
+                             TileStoreOptions tiling, bool first_cut_made);
+
 // The default budget: half of the machine's physical memory.
 std::uint64_t default_memory_budget();
 
