@@ -251,8 +251,9 @@ void add_mesh_command(CLI::App& app) {
   cmd->add_option(
          "--memory", args->memory,
          "Memory budget, e.g. 512M or 4G (default: half the machine's RAM): sets the "
-         "tile size and the tiles in flight; the peak resident memory stays below it (below "
-         "about 100M, only for clouds of a few million points)")
+         "tile size and the tiles in flight, with room for the band of open seams predicted "
+         "from the tiles; the peak resident memory stays below it, or a warning says that the "
+         "band cannot fit")
       ->transform(byte_size());
   cmd->add_option("--tile-points", args->tile_points,
                   "Largest number of points in a tile (default: a quarter of the cloud, at "
@@ -262,7 +263,8 @@ void add_mesh_command(CLI::App& app) {
   cmd->add_option("--keep-store", args->keep_store,
                   "Keep the tile store at this path instead of a temporary beside the output; "
                   "the next run reuses it if it was made from the same input (path, size, "
-                  "time, content) with the same --tile-points, else tiles again");
+                  "time, content) with the same tiling (--tile-points, or the first cut --memory "
+                  "plans), else tiles again");
   cmd->add_flag("--compress", args->compress, "zstd-compress the tile store");
   add_mesh_options(*cmd, args->options);
   // Every stage in one arena of --threads threads: the tiling and the output keep to the count
