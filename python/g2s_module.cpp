@@ -17,11 +17,9 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <optional>
 #include <string>
-#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -212,22 +210,9 @@ py::dict mesh_file(const std::filesystem::path& input, const std::filesystem::pa
       tile_points > 0 ? tile_points : g2s::plan_memory(budget, options.threads).tile_points;
   // A kept store made from this input for this plan is reused, as `g2s mesh --keep-store` does;
   // a file there that is no tile store is refused rather than overwritten.
-  bool first_cut_made = false;
-  if (!temporary && std::filesystem::exists(store_path)) {
-    char magic[8] = {};
-    std::ifstream(store_path, std::ios::binary).read(magic, sizeof magic);
-    if (std::string_view(magic, sizeof magic) != "G2STILES") {
-      throw g2s::Error(g2s::Exit::usage, "keep_store " + store_path.string() +
-                                             ": the file there is not a g2s tile store; refusing "
-                                             "to overwrite it");
-    }
-    try {
-      first_cut_made =
-          g2s::TileStore(store_path).origin() == g2s::store_origin(input, planned_tile);
-    } catch (const g2s::Error& e) {
-      if (e.code() != g2s::Exit::bad_input) throw;  // another version or damaged: cut afresh
-    }
-  }
+  std::string why;
+  const bool first_cut_made =
+      !temporary && g2s::kept_store_matches(store_path, input, planned_tile, why);
   // Cut as g2s mesh cuts for the same budget: the same tiles, so the same mesh.
   g2s::TileStoreOptions tiling;
   tiling.tile_points = tile_points;

@@ -11,10 +11,8 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <optional>
-#include <string_view>
 
 #include "cli_checks.hpp"
 #include "commands.hpp"
@@ -41,38 +39,17 @@ struct MeshArgs {
 
 // A kept store is reused only when it was made from this input (path, size, time, content
 // fingerprint) with this tiling; an older or other store is rebuilt, with a note. A file there
-// that is no tile store at all is refused rather than overwritten.
+// that is no tile store at all is refused rather than overwritten (kept_store_matches).
 bool reusable(const std::filesystem::path& store, const std::filesystem::path& input,
               std::uint64_t tile_points, bool quiet) {
-  std::error_code error;
-  if (!std::filesystem::exists(store, error)) return false;
-  {
-    char magic[8] = {};
-    std::ifstream in(store, std::ios::binary);
-    in.read(magic, sizeof magic);
-    if (!std::filesystem::is_regular_file(store, error) || !in ||
-        std::string_view(magic, sizeof magic) != "G2STILES") {
-      throw Error(Exit::usage,
-                  fmt::format("--keep-store {}: the file there is not a g2s tile store; refusing "
-                              "to overwrite it (choose another path)",
-                              store.string()));
-    }
-  }
   std::string why;
   try {
-    const TileStore kept(store);
-    if (kept.origin() == store_origin(input, tile_points)) return true;
-    why = kept.origin().tile_points != tile_points
-              ? fmt::format(
-                    "was cut into tiles of at most {} points, not {} (--tile-points, "
-                    "--memory)",
-                    kept.origin().tile_points, tile_points)
-              : fmt::format("was made from another file or version of {}", input.string());
+    if (kept_store_matches(store, input, tile_points, why)) return true;
   } catch (const Error& e) {
-    if (e.code() != Exit::bad_input) throw;
-    why = fmt::format("cannot be reused ({})", e.what());
+    if (e.code() != Exit::usage) throw;
+    throw Error(e.code(), fmt::format("--keep-store {}", e.what()));
   }
-  if (!quiet) {
+  if (!quiet && !why.empty()) {
     fmt::print(stderr, "g2s: note: --keep-store {} {}; tiling again\n", store.string(), why);
   }
   return false;

@@ -12,6 +12,7 @@
 #include <functional>
 #include <memory>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "g2s/io.hpp"
@@ -83,6 +84,13 @@ struct StoreOrigin {
 // The origin a store built now from `input` with `tile_points` would record. Throws
 // Error(bad_input) when the input cannot be opened or read.
 StoreOrigin store_origin(const std::filesystem::path& input, std::uint64_t tile_points);
+
+// Whether a kept store at `store` can be reused for `input` cut with `tile_points`: it was made
+// from this input (StoreOrigin) with this tiling. When not (none there, another input or
+// tiling, another version or damaged), returns false and, if there was a store, why in `why`.
+// A file there that is no tile store throws Error(usage): it is refused rather than overwritten.
+bool kept_store_matches(const std::filesystem::path& store, const std::filesystem::path& input,
+                        std::uint64_t tile_points, std::string& why);
 
 // Reads `input` (any format read_points accepts) in streaming passes with bounded memory and
 // writes the store atomically at `store` (temporary name, renamed when complete). Global ids

@@ -16,6 +16,7 @@
 // vote is clear; others as it connects them), and the end flips each group so that all of a
 // component faces one way, and the component outward as the in-memory mesher does.
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -299,8 +300,8 @@ class SeamStitcher {
 };
 
 // When the seams are done with a point: per tile, the seams' reach and the faces other tiles lie
-// beyond, measured as the stitcher measures (Stitcher::prepare) and as peak_live_points
-// predicts.
+// beyond, measured as the stitcher measures (Stitcher::prepare) and as
+// predict_peak_live_points predicts.
 struct SeamSteps {
   SeamSteps(std::span<const TileInfo> all, const PipelineOptions& options) : tiles(all) {
     for (std::size_t t = 0; t < all.size(); ++t) {
@@ -427,7 +428,6 @@ PreparedTile& PreparedTile::operator=(PreparedTile&&) noexcept = default;
 
 PreparedTile Stitcher::prepare(std::size_t tile, TileGrowth growth) const {
   const Impl& m = *impl_;
-  const std::span<const TileInfo> tiles = m.source.tiles();
   const TilePoints points =
       growth.points.size() == growth.report.points ? std::move(growth.points) : m.source.load(tile);
   growth.points = TilePoints{};
@@ -587,40 +587,33 @@ PipelineSummary Stitcher::finish() {
 std::uint64_t predict_peak_live_points(const TileSource& source, const PipelineOptions& options) {
   const std::span<const TileInfo> tiles = source.tiles();
   const SeamSteps steps(tiles, options);
-  // Per tile: how many of its held points each step releases (index 0: the tile's own step,
-  // k > 0: its k-th later tile within reach).
-  std::vector<std::vector<std::uint64_t>> released(tiles.size());
+  // Per thread: the change in points held at each step (+1 at a point's tile, -1 after the step
+  // that releases it).
+  tbb::enumerable_thread_specific<std::vector<std::int64_t>> changes(
+      std::vector<std::int64_t>(tiles.size() + 1, 0));
+  const auto count_tile = [&](std::size_t t, std::vector<std::size_t>& later) {
+    double inside = 0;
+    steps.later_near(t, later, inside);
+    std::vector<std::int64_t>& change = changes.local();
+    const TilePoints points = source.load(t);
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      const double* p = &points.xyz[3 * k];
+      const std::uint32_t release = steps.last_step(t, p, later, inside, true);
+      if (!steps.listed(t, p, release)) continue;
+      ++change[t];
+      --change[release + 1];
+    }
+  };
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tiles.size(), 1),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       std::vector<std::size_t> later;
-                      double inside = 0;
                       for (std::size_t t = range.begin(); t < range.end(); ++t) {
-                        if (tiles[t].points == 0) continue;
-                        steps.later_near(t, later, inside);
-                        std::vector<std::uint64_t>& count = released[t];
-                        count.assign(later.size() + 1, 0);
-                        const TilePoints points = source.load(t);
-                        for (std::size_t k = 0; k < points.size(); ++k) {
-                          const double* p = &points.xyz[3 * k];
-                          const std::uint32_t step = steps.last_step(t, p, later, inside, true);
-                          if (!steps.listed(t, p, step)) continue;
-                          const auto at = std::find(later.begin(), later.end(), step);
-                          ++count[at == later.end() ? 0 : 1 + (at - later.begin())];
-                        }
+                        if (tiles[t].points > 0) count_tile(t, later);
                       }
                     });
-  // Points held from their tile's step through their release step.
   std::vector<std::int64_t> change(tiles.size() + 1, 0);
-  std::vector<std::size_t> later;
-  double inside = 0;
-  for (std::size_t t = 0; t < tiles.size(); ++t) {
-    if (released[t].empty()) continue;
-    steps.later_near(t, later, inside);
-    for (std::size_t k = 0; k < released[t].size(); ++k) {
-      const std::size_t last = k == 0 ? t : later[k - 1];
-      change[t] += static_cast<std::int64_t>(released[t][k]);
-      change[last + 1] -= static_cast<std::int64_t>(released[t][k]);
-    }
+  for (const std::vector<std::int64_t>& local : changes) {
+    for (std::size_t step = 0; step < change.size(); ++step) change[step] += local[step];
   }
   std::int64_t held = 0, peak = 0;
   for (const std::int64_t c : change) peak = std::max(peak, held += c);

@@ -10,7 +10,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "g2s/error.hpp"
@@ -323,6 +326,37 @@ TilePoints TileStore::load_border(std::size_t tile, double distance) const {
   out.xyz.resize(3 * lo);
   out.ids.resize(lo);
   return out;
+}
+
+bool kept_store_matches(const std::filesystem::path& store, const std::filesystem::path& input,
+                        std::uint64_t tile_points, std::string& why) {
+  std::error_code error;
+  if (!std::filesystem::exists(store, error)) return false;
+  {
+    char magic[8] = {};
+    std::ifstream in(store, std::ios::binary);
+    in.read(magic, sizeof magic);
+    if (!std::filesystem::is_regular_file(store, error) || !in ||
+        std::string_view(magic, sizeof magic) != "G2STILES") {
+      throw Error(Exit::usage, fmt::format("{}: the file there is not a g2s tile store; refusing "
+                                           "to overwrite it (choose another path)",
+                                           store.string()));
+    }
+  }
+  try {
+    const TileStore kept(store);
+    if (kept.origin() == store_origin(input, tile_points)) return true;
+    why = kept.origin().tile_points != tile_points
+              ? fmt::format(
+                    "was cut into tiles of at most {} points, not {} (--tile-points, "
+                    "--memory)",
+                    kept.origin().tile_points, tile_points)
+              : fmt::format("was made from another file or version of {}", input.string());
+  } catch (const Error& e) {
+    if (e.code() != Exit::bad_input) throw;
+    why = fmt::format("cannot be reused ({})", e.what());
+  }
+  return false;
 }
 
 }  // namespace g2s
