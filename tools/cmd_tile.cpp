@@ -7,9 +7,11 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "cli_checks.hpp"
 #include "commands.hpp"
+#include "g2s/tile_stages.hpp"
 #include "g2s/tile_store.hpp"
 #include "json_writer.hpp"
 #include "progress.hpp"
@@ -76,6 +78,9 @@ void run_tile_info(const TileInfoArgs& args) {
   for (std::size_t t = 0; t < store.tiles().size(); ++t) store.load(t);
   const ReadReport& in = store.input_report();
   const TileBox& b = store.bounds();
+  // The neighbours' points each tile grows with (g2s grow's default halo): what a tile costs to
+  // grow is its points and these.
+  const std::vector<std::uint64_t> halo = count_halo_points(store, PipelineOptions{});
   if (args.json) {
     JsonObject input;
     input.text("format", in.format)
@@ -87,6 +92,7 @@ void run_tile_info(const TileInfoArgs& args) {
       const TileInfo& info = store.tiles()[t];
       JsonObject tile;
       tile.number("points", info.points)
+          .number("halo_points", halo[t])
           .number("spacing", info.spacing)
           .raw("box", box_json(info.box));
       tiles += (t > 0 ? "," : "") + tile.str();
@@ -109,12 +115,13 @@ void run_tile_info(const TileInfoArgs& args) {
              b.hi[1], b.hi[2]);
   fmt::print("input:      {}, {} declared, {} points, {} non-finite dropped\n", in.format,
              in.declared, in.points, in.non_finite);
-  fmt::print("{:>6} {:>10} {:>12}  box\n", "tile", "points", "spacing");
+  fmt::print("{:>6} {:>10} {:>10} {:>12}  box\n", "tile", "points", "halo", "spacing");
   for (std::size_t t = 0; t < store.tiles().size(); ++t) {
     const TileInfo& info = store.tiles()[t];
     const TileBox& x = info.box;
-    fmt::print("{:>6} {:>10} {:>12.6g}  [{:.6g}, {:.6g}, {:.6g}] - [{:.6g}, {:.6g}, {:.6g}]\n", t,
-               info.points, info.spacing, x.lo[0], x.lo[1], x.lo[2], x.hi[0], x.hi[1], x.hi[2]);
+    fmt::print(
+        "{:>6} {:>10} {:>10} {:>12.6g}  [{:.6g}, {:.6g}, {:.6g}] - [{:.6g}, {:.6g}, {:.6g}]\n", t,
+        info.points, halo[t], info.spacing, x.lo[0], x.lo[1], x.lo[2], x.hi[0], x.hi[1], x.hi[2]);
   }
 }
 

@@ -9,6 +9,10 @@
 // points a deletion may split nearer the border go on to the stitcher as suspects. Triangles
 // deeper still, beyond the stitcher's release margin too, are final: they come first, counted,
 // and the stitcher passes them to the output without holding them.
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <chrono>
 
@@ -79,15 +83,20 @@ void put_final_first(TileGrowth& out, const TileFaces& faces, double depth) {
   out.final_triangles = final_count;
 }
 
+// The halo's width around `tile`: halo_spacings of the largest spacing around it.
+double halo_width(std::span<const TileInfo> tiles, std::size_t tile,
+                  const PipelineOptions& options) {
+  const double first = options.halo_spacings * tiles[tile].spacing;
+  return options.halo_spacings * local_spacing(tiles, tile, tiles_near(tiles, tile, first));
+}
+
 }  // namespace
 
 TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   const std::span<const TileInfo> tiles = source.tiles();
   const TileBox& box = tiles[tile].box;
-  const double halo_first = options.halo_spacings * tiles[tile].spacing;
-  const std::vector<std::size_t> near0 = tiles_near(tiles, tile, halo_first);
-  const double halo = options.halo_spacings * local_spacing(tiles, tile, near0);
+  const double halo = halo_width(tiles, tile, options);
 
   TilePoints points = source.load(tile);
   const std::size_t own = points.size();
@@ -170,6 +179,49 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
   out.report.seconds_grow =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - grow_start).count();
   return out;
+}
+
+std::vector<std::uint64_t> count_halo_points(const TileSource& source,
+                                             const PipelineOptions& options) {
+  const std::span<const TileInfo> tiles = source.tiles();
+  std::vector<double> halo(tiles.size(), 0.0);
+  for (std::size_t t = 0; t < tiles.size(); ++t) {
+    if (tiles[t].points > 0) halo[t] = halo_width(tiles, t, options);
+  }
+  tbb::enumerable_thread_specific<std::vector<std::uint64_t>> counts(
+      std::vector<std::uint64_t>(tiles.size(), 0));
+  // Each tile's points go to the halos of the tiles near it, as grow_tile gathers them: only a
+  // prefix of the tile's block (its border) can lie within a halo of another box.
+  const auto give = [&](std::size_t j, std::vector<std::size_t>& takers) {
+    takers.clear();
+    double widest = 0;
+    for (std::size_t t = 0; t < tiles.size(); ++t) {
+      if (t != j && tiles[t].points > 0 && box_gap(tiles[t].box, tiles[j].box) <= halo[t]) {
+        takers.push_back(t);
+        widest = std::max(widest, halo[t]);
+      }
+    }
+    if (takers.empty()) return;
+    std::vector<std::uint64_t>& count = counts.local();
+    const TilePoints border = source.load_border(j, widest);
+    for (std::size_t k = 0; k < border.size(); ++k) {
+      for (const std::size_t t : takers) {
+        count[t] += box_distance(tiles[t].box, &border.xyz[3 * k]) <= halo[t];
+      }
+    }
+  };
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tiles.size(), 1),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      std::vector<std::size_t> takers;
+                      for (std::size_t j = range.begin(); j < range.end(); ++j) {
+                        if (tiles[j].points > 0) give(j, takers);
+                      }
+                    });
+  std::vector<std::uint64_t> total(tiles.size(), 0);
+  for (const std::vector<std::uint64_t>& local : counts) {
+    for (std::size_t t = 0; t < total.size(); ++t) total[t] += local[t];
+  }
+  return total;
 }
 
 }  // namespace g2s

@@ -1,4 +1,5 @@
-// Adaptive k-d split (see tile_split.hpp): midpoint or quantile cuts on a deterministic sample.
+// Adaptive k-d split (see tile_split.hpp): each cut across the axis with the fewest points near
+// it, at the midpoint or a quantile, on a deterministic sample.
 #include "tiling/tile_split.hpp"
 
 #include <algorithm>
@@ -14,6 +15,53 @@ namespace {
 // tiles (on the bun000 scan at 1000 points per tile: 1/4 gives 52 tiles, 1/8 gives 60, any
 // non-empty side 68, for 41 full ones).
 constexpr std::ptrdiff_t kMinShare = 8;
+// The width on each side of a cut within which its points are counted, as a share of the widest
+// extent of the node's points: the halo's (8 spacings) beside a square patch of surface of about
+// 64k points, the tiles of a tight --memory; wider beside larger nodes, which only ranks the
+// axes the same way.
+constexpr double kSeamWidthShare = 1.0 / 32;
+
+// The cut of a node across `axis`: the box's midpoint when it leaves each side at least
+// 1/kMinShare of the points (compact tiles, fewer border points to exchange, closing in on dense
+// regions), else the quantile lower_share. False when every point lies on one plane across it.
+bool cut_along(const PointSample& sample, std::uint32_t* begin, std::uint32_t* end,
+               const TileBox& box, int axis, double lower_share, double& cut) {
+  auto coord = [&](std::uint32_t i) { return sample.point(i)[axis]; };
+  auto by_coord = [&](std::uint32_t i, std::uint32_t j) { return coord(i) < coord(j); };
+  cut = 0.5 * (box.lo[axis] + box.hi[axis]);
+  const auto below = std::count_if(begin, end, [&](std::uint32_t i) { return coord(i) < cut; });
+  if (kMinShare * below < end - begin || kMinShare * below > (kMinShare - 1) * (end - begin)) {
+    // Otherwise the quantile, so that an uneven node still splits into nearly full tiles.
+    std::uint32_t* middle =
+        begin + static_cast<std::ptrdiff_t>(static_cast<double>(end - begin) * lower_share);
+    std::nth_element(begin, middle, end, by_coord);
+    cut = coord(*middle);
+    const double lowest = coord(*std::min_element(begin, end, by_coord));
+    if (cut == lowest) {
+      // The points below the cut share the lowest coordinate: cut just above them.
+      bool found = false;
+      for (const std::uint32_t* i = begin; i != end; ++i) {
+        if (coord(*i) > lowest && (!found || coord(*i) < cut)) {
+          cut = coord(*i);
+          found = true;
+        }
+      }
+      if (!found) return false;  // all on one plane across this axis
+    }
+    if (cut == box.hi[axis]) {
+      // Many points lie on the box's upper face, which is the cloud's: cutting there would
+      // leave a flat tile on the cloud's face, a neighbour that the face rules out of the
+      // lower tile's border. Cut halfway below them instead.
+      double next_lower = lowest;
+      for (const std::uint32_t* i = begin; i != end; ++i) {
+        if (coord(*i) < cut) next_lower = std::max(next_lower, coord(*i));
+      }
+      const double halfway = 0.5 * (next_lower + cut);
+      if (next_lower < halfway && halfway < cut) cut = halfway;
+    }
+  }
+  return true;
+}
 
 }  // namespace
 
@@ -51,43 +99,42 @@ void TileTree::split_range(std::uint32_t node, const PointSample& sample, std::u
   std::array<int, 3> axes = {0, 1, 2};
   std::stable_sort(axes.begin(), axes.end(),
                    [&](int a, int b) { return box.hi[a] - box.lo[a] > box.hi[b] - box.lo[b]; });
+  // The extent of the node's points along each axis.
+  double extent[3] = {0, 0, 0};
+  for (int a = 0; a < 3; ++a) {
+    const auto [lo, hi] = std::minmax_element(begin, end, [&](std::uint32_t i, std::uint32_t j) {
+      return sample.point(i)[a] < sample.point(j)[a];
+    });
+    extent[a] = sample.point(*hi)[a] - sample.point(*lo)[a];
+  }
+  const double widest = *std::max_element(std::begin(extent), std::end(extent));
+  // Each axis's cut, then the one with the fewest points near it among the axes along which the
+  // points reach at least 2/3 as far as along the widest (so that tiles stay compact and a
+  // dense cluster still gets cut down to tiles of its own): a seam costs by the points within
+  // a halo's width of it, and a plane meeting the surface at a glancing angle (a horizontal cut
+  // through sloping terrain) has many more of them than its length says. Ties keep the longest
+  // side of the box.
+  const double near = widest * kSeamWidthShare;
+  int best_axis = -1;
+  double best_cut = 0;
+  std::pair<bool, std::ptrdiff_t> best_score;  // (too narrow, points near the cut)
   for (const int axis : axes) {
-    auto coord = [&](std::uint32_t i) { return sample.point(i)[axis]; };
-    auto by_coord = [&](std::uint32_t i, std::uint32_t j) { return coord(i) < coord(j); };
-    // The box's midpoint when it leaves each side at least 1/kMinShare of the points: compact
-    // tiles (fewer border points to exchange) that close in on dense regions.
-    double cut = 0.5 * (box.lo[axis] + box.hi[axis]);
-    const auto below = std::count_if(begin, end, [&](std::uint32_t i) { return coord(i) < cut; });
-    if (kMinShare * below < end - begin || kMinShare * below > (kMinShare - 1) * (end - begin)) {
-      // Otherwise the quantile, so that an uneven node still splits into nearly full tiles.
-      std::uint32_t* middle =
-          begin + static_cast<std::ptrdiff_t>(static_cast<double>(end - begin) * lower_share);
-      std::nth_element(begin, middle, end, by_coord);
-      cut = coord(*middle);
-      const double lowest = coord(*std::min_element(begin, end, by_coord));
-      if (cut == lowest) {
-        // The points below the cut share the lowest coordinate: cut just above them.
-        bool found = false;
-        for (const std::uint32_t* i = begin; i != end; ++i) {
-          if (coord(*i) > lowest && (!found || coord(*i) < cut)) {
-            cut = coord(*i);
-            found = true;
-          }
-        }
-        if (!found) continue;  // all on one plane across this axis
-      }
-      if (cut == box.hi[axis]) {
-        // Many points lie on the box's upper face, which is the cloud's: cutting there would
-        // leave a flat tile on the cloud's face, a neighbour that the face rules out of the
-        // lower tile's border. Cut halfway below them instead.
-        double next_lower = lowest;
-        for (const std::uint32_t* i = begin; i != end; ++i) {
-          if (coord(*i) < cut) next_lower = std::max(next_lower, coord(*i));
-        }
-        const double halfway = 0.5 * (next_lower + cut);
-        if (next_lower < halfway && halfway < cut) cut = halfway;
-      }
+    double cut = 0;
+    if (!cut_along(sample, begin, end, box, axis, lower_share, cut)) continue;
+    const auto close = std::count_if(
+        begin, end, [&](std::uint32_t i) { return std::abs(sample.point(i)[axis] - cut) <= near; });
+    const std::pair<bool, std::ptrdiff_t> score{3 * extent[axis] < 2 * widest, close};
+    if (best_axis < 0 || score < best_score) {
+      best_axis = axis;
+      best_cut = cut;
+      best_score = score;
     }
+  }
+  if (best_axis < 0) return;  // all points coincide
+  {
+    const int axis = best_axis;
+    const double cut = best_cut;
+    auto coord = [&](std::uint32_t i) { return sample.point(i)[axis]; };
     std::uint32_t* mid =
         std::partition(begin, end, [&](std::uint32_t i) { return coord(i) < cut; });
     Node lower{box};

@@ -19,6 +19,8 @@
 #include "g2s/pipeline.hpp"
 #include "g2s/stats.hpp"
 #include "g2s/synth.hpp"
+#include "g2s/tile_stages.hpp"
+#include "g2s/tile_store.hpp"
 #include "support/cli.hpp"
 #include "support/temp_folder.hpp"
 
@@ -75,6 +77,28 @@ TEST_F(Stages, SeparateProcessesGiveTheBytesOfOneMeshRunForAnyThreadCount) {
   std::string err;
   ASSERT_EQ(run({"grow", "s.store"}, &err), 0);
   EXPECT_NE(err.find("(" + std::to_string(tiles) + " already there)"), std::string::npos) << err;
+}
+
+// tile-info shows each tile's halo, as count_halo_points counts it, so that a tile-by-tile
+// pipeline can size a machine by what a tile grows with.
+TEST_F(Stages, TileInfoShowsEachTilesHalo) {
+  ASSERT_EQ(run({"tile", "torus.ply", "s.store", "--tile-points", "2000", "-q"}), 0);
+  const g2s::test_support::CliRun info =
+      g2s::test_support::run_cli(dir_, {"tile-info", "s.store", "--json"});
+  ASSERT_EQ(info.code, 0) << info.err;
+  const g2s::TileStore store(dir_ / "s.store");
+  const std::vector<std::uint64_t> halo = g2s::count_halo_points(store, {});
+  ASSERT_GE(halo.size(), 10u);
+  std::size_t at = 0;
+  for (std::size_t t = 0; t < halo.size(); ++t) {
+    at = info.out.find("\"halo_points\":", at);
+    ASSERT_NE(at, std::string::npos) << "tile " << t;
+    EXPECT_EQ(std::strtoull(info.out.c_str() + at + 14, nullptr, 10), halo[t]) << "tile " << t;
+    EXPECT_GT(halo[t], 0u);
+    ++at;
+  }
+  const std::string text = g2s::test_support::cli_output(dir_, {"tile-info", "s.store"}, 0);
+  EXPECT_NE(text.find("halo"), std::string::npos);
 }
 
 TEST_F(Stages, GnuParallelDrivesTheGrowStage) {
