@@ -235,23 +235,6 @@ Pairs TriangleCells::crossing_pairs() const {
   return sorted_union(found);
 }
 
-std::int64_t TriangleCells::Level::coord(float v) const {
-  const double c = std::floor(v * inverse_cell);
-  return static_cast<std::int64_t>(std::clamp(c, double(-kBias), double(kBias - 1)));
-}
-
-std::uint64_t TriangleCells::key(std::int64_t x, std::int64_t y, std::int64_t z) {
-  return static_cast<std::uint64_t>(x + kBias) << 42 | static_cast<std::uint64_t>(y + kBias) << 21 |
-         static_cast<std::uint64_t>(z + kBias);
-}
-
-std::size_t TriangleCells::Level::find(std::uint64_t k) const {
-  for (std::size_t s = (k * 0x9E3779B97F4A7C15ull) >> shift;; s = (s + 1) & (keys.size() - 1)) {
-    if (keys[s] == k) return s;
-    if (keys[s] == kEmpty) return keys.size();
-  }
-}
-
 void TriangleCells::build(Level& level, std::span<const std::uint32_t> members) {
   const auto key_of = [&](const Box& box) {
     return key(level.coord(box.lo.x), level.coord(box.lo.y), level.coord(box.lo.z));

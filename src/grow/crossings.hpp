@@ -95,12 +95,26 @@ class TriangleCells {
     std::vector<std::uint32_t> filed;  // triangle indices grouped by cell
     std::vector<Box> boxes;            // their boxes, in the same order
     int shift = 60;
-    std::int64_t coord(float v) const;
-    std::size_t find(std::uint64_t key) const;  // slot, or keys.size()
+    // The cell coordinate of v, clamped to the keys' range: floor, clamped first so that the
+    // integer conversion does it (no call to floor; these run in every query).
+    std::int64_t coord(float v) const {
+      const double c = std::clamp(v * inverse_cell, double(-kBias), double(kBias - 1));
+      const auto i = static_cast<std::int64_t>(c);
+      return c < static_cast<double>(i) ? i - 1 : i;
+    }
+    std::size_t find(std::uint64_t k) const {  // slot, or keys.size()
+      for (std::size_t s = (k * 0x9E3779B97F4A7C15ull) >> shift;; s = (s + 1) & (keys.size() - 1)) {
+        if (keys[s] == k) return s;
+        if (keys[s] == kEmpty) return keys.size();
+      }
+    }
   };
   static constexpr std::uint64_t kEmpty = ~0ull;
   static constexpr std::int64_t kBias = std::int64_t{1} << 20;  // added to cell coordinates
-  static std::uint64_t key(std::int64_t x, std::int64_t y, std::int64_t z);
+  static std::uint64_t key(std::int64_t x, std::int64_t y, std::int64_t z) {
+    return static_cast<std::uint64_t>(x + kBias) << 42 |
+           static_cast<std::uint64_t>(y + kBias) << 21 | static_cast<std::uint64_t>(z + kBias);
+  }
   void build(Level& level, std::span<const std::uint32_t> members);
   // Calls visit(e) for the places e in level.filed of the triangles whose lower corner lies in
   // the cells that [lo - cell, hi] covers: every filed triangle whose box can overlap [lo, hi].
