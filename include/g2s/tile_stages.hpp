@@ -55,9 +55,9 @@ struct PipelineOptions {
 // Grows one tile with its halo. Deterministic; independent of the other tiles.
 TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineOptions& options);
 
-// Per tile, the neighbours' points grow_tile takes into its halo (the tile's own points aside).
-// Reads only the tiles' borders, in parallel. g2s mesh sizes its tiles with it under a tight
-// --memory (docs/pipeline.md, "Memory").
+// Per tile, the neighbours' points grow_tile takes into its halo (the tile's own points aside):
+// with its own points, what a tile costs to grow (g2s tile-info shows it; docs/pipeline.md,
+// "Memory"). Reads only the tiles' borders, in parallel.
 std::vector<std::uint64_t> count_halo_points(const TileSource& source,
                                              const PipelineOptions& options);
 

@@ -131,27 +131,21 @@ void TileTree::split_range(std::uint32_t node, const PointSample& sample, std::u
     }
   }
   if (best_axis < 0) return;  // all points coincide
-  {
-    const int axis = best_axis;
-    const double cut = best_cut;
-    auto coord = [&](std::uint32_t i) { return sample.point(i)[axis]; };
-    std::uint32_t* mid =
-        std::partition(begin, end, [&](std::uint32_t i) { return coord(i) < cut; });
-    Node lower{box};
-    Node upper{box};
-    lower.box.hi[axis] = cut;
-    upper.box.lo[axis] = cut;
-    const auto left = static_cast<std::uint32_t>(nodes_.size());
-    nodes_.push_back(lower);
-    nodes_.push_back(upper);
-    nodes_[node].axis = axis;
-    nodes_[node].split = cut;
-    nodes_[node].left = left;
-    nodes_[node].right = left + 1;
-    split_range(left, sample, begin, mid, weight, target);
-    split_range(left + 1, sample, mid, end, weight, target);
-    return;
-  }
+  std::uint32_t* mid = std::partition(
+      begin, end, [&](std::uint32_t i) { return sample.point(i)[best_axis] < best_cut; });
+  Node lower{box};
+  Node upper{box};
+  lower.box.hi[best_axis] = best_cut;
+  upper.box.lo[best_axis] = best_cut;
+  const auto left = static_cast<std::uint32_t>(nodes_.size());
+  nodes_.push_back(lower);
+  nodes_.push_back(upper);
+  nodes_[node].axis = best_axis;
+  nodes_[node].split = best_cut;
+  nodes_[node].left = left;
+  nodes_[node].right = left + 1;
+  split_range(left, sample, begin, mid, weight, target);
+  split_range(left + 1, sample, mid, end, weight, target);
 }
 
 void TileTree::taper(const PointSample& sample, double weight, double smallest) {

@@ -2,11 +2,10 @@
 // split"): a k-d tree over the cloud's bounding box whose leaves are the tiles. A leaf holding
 // too many points is cut across the axis whose cut has the fewest points near it (a seam's
 // cost; among the axes along which the points reach nearly as far as along the widest), at the
-// box's midpoint when that leaves each
-// side at least 1/8 of its points (compact tiles, closing in on dense regions), else at a
-// quantile of a sample of its points (the median when it needs two tiles, k/2 of k when it
-// needs k, so tiles come out nearly full). Empty space costs nothing. The sample is a
-// deterministic hash of the points' global ids, so the tiles do not depend on chunking,
+// box's midpoint when that leaves each side at least 1/8 of its points (compact tiles, closing
+// in on dense regions), else at a quantile of a sample of its points (the median when it needs two
+// tiles, k/2 of k when it needs k, so tiles come out nearly full). Empty space costs nothing. The
+// sample is a deterministic hash of the points' global ids, so the tiles do not depend on chunking,
 // threads or timing.
 #pragma once
 

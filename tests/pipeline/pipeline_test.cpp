@@ -141,7 +141,7 @@ TEST(Pipeline, HaloCountsAreTheNeighboursPointsWithinEachHalo) {
 // seams along the contour lines, and each thin horizontal slab grew with a halo up to twice its
 // own points (6.0M points in 144 tiles: 54% more points grown on average, 233% at worst; now
 // 19% and 32% in 146 tiles). A halo 8 spacings wide around a square tile of about 40k surface
-// points is about a seventh of them on a flat surface.
+// points is about a sixth of them on a flat surface.
 TEST(Pipeline, TilesOfAMountainScanGrowWithThinHalos) {
   const std::filesystem::path path = data_dir() / "open-alpe-selle-photogrammetry.ply";
   G2S_SKIP_WITHOUT_DATA(path);
