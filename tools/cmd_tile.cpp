@@ -102,6 +102,7 @@ void run_tile_info(const TileInfoArgs& args) {
         .number("points", store.point_count())
         .number("compressed", store.compressed())
         .raw("bounds", box_json(b))
+        .number("spacing", store.cloud_spacing())
         .raw("input", input.str())
         .raw("tiles", tiles + "]");
     fmt::print("{}\n", json.str());
@@ -113,6 +114,8 @@ void run_tile_info(const TileInfoArgs& args) {
   fmt::print("blocks:     {}\n", store.compressed() ? "zstd" : "raw");
   fmt::print("bounds:     [{}, {}, {}] - [{}, {}, {}]\n", b.lo[0], b.lo[1], b.lo[2], b.hi[0],
              b.hi[1], b.hi[2]);
+  fmt::print("spacing:    {:.6g} (the cloud's median nearest-neighbour distance)\n",
+             store.cloud_spacing());
   fmt::print("input:      {}, {} declared, {} points, {} non-finite dropped\n", in.format,
              in.declared, in.points, in.non_finite);
   fmt::print("{:>6} {:>10} {:>10} {:>12}  box\n", "tile", "points", "halo", "spacing");

@@ -31,6 +31,10 @@ struct GrowContext {
   // Per grid point, non-zero: may be a corner of a triangle that fills a hole (a tile's points
   // out of every seam's reach: holes nearer a seam are the seam's); empty: every growable one.
   std::span<const std::uint8_t> fillable;
+  // The whole cloud's spacing (a tile's or a seam's grid sees only part of it), or 0: the
+  // search radius is capped at max_radius times the larger of it and the grid's own spacing,
+  // so that a region denser than the cloud bridges the gaps the cloud's sampling leaves.
+  double cloud_spacing = 0;
 };
 
 struct GrowResult {

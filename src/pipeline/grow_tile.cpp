@@ -128,6 +128,7 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
   }
   GrowContext context;
   context.fillable = fillable;
+  context.cloud_spacing = source.cloud_spacing();
   GrowResult grown = grow_mesh(grid, mesh_options, context);
   fillable = std::vector<std::uint8_t>();
   out.report.seeds = grown.seeds;

@@ -49,7 +49,8 @@ MemoryTiles::MemoryTiles(const PointCloud& cloud, std::uint64_t tile_points) : c
   // The tile store's split, on every point (its exact case).
   tiling::PointSample sample(cloud.size());
   for (std::size_t i = 0; i < cloud.size(); ++i) sample.add(&cloud.xyz[3 * i], i);
-  tiling::TileTree tree(bounding_box(cloud));
+  const TileBox bounds = bounding_box(cloud);
+  tiling::TileTree tree(bounds);
   if (cloud.size() > 0) {
     const double budget = static_cast<double>(std::max<std::uint64_t>(tile_points, 1));
     tree.split(0, sample, 1.0, budget);
@@ -66,7 +67,7 @@ MemoryTiles::MemoryTiles(const PointCloud& cloud, std::uint64_t tile_points) : c
   for (Index i = 0; i < cloud.size(); ++i) {
     members[tile_of_node[tree.leaf_of(&cloud.xyz[3 * std::size_t{i}])]].push_back(i);
   }
-  finish(std::move(members));
+  finish(std::move(members), bounds);
 }
 
 MemoryTiles::MemoryTiles(const PointCloud& cloud, std::vector<TileBox> boxes) : cloud_(cloud) {
@@ -80,15 +81,22 @@ MemoryTiles::MemoryTiles(const PointCloud& cloud, std::vector<TileBox> boxes) : 
     members[owner].push_back(i);
   }
   for (const TileBox& box : boxes) info_.push_back({box, 0, 0.0});
-  finish(std::move(members));
+  finish(std::move(members), bounds);
 }
 
-void MemoryTiles::finish(std::vector<std::vector<Index>> members) {
+void MemoryTiles::finish(std::vector<std::vector<Index>> members, const TileBox& bounds) {
   members_ = std::move(members);
+  std::vector<double> cloud_sample;
   for (std::size_t t = 0; t < info_.size(); ++t) {
     info_[t].points = members_[t].size();
-    info_[t].spacing = tiling::estimate_tile_spacing(load(t).xyz);
+    const TilePoints points = load(t);
+    tiling::TileSpacing spacing =
+        tiling::measure_tile_spacing(points.xyz, points.ids, info_[t].box, bounds, cloud_.size());
+    info_[t].spacing = spacing.mean;
+    cloud_sample.insert(cloud_sample.end(), spacing.cloud_sample.begin(),
+                        spacing.cloud_sample.end());
   }
+  cloud_spacing_ = tiling::cloud_spacing(std::move(cloud_sample));
 }
 
 TilePoints MemoryTiles::load(std::size_t tile) const {

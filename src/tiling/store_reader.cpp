@@ -50,6 +50,7 @@ struct TileStore::Impl {
   TileBox bounds;
   ReadReport input;
   StoreOrigin origin;
+  double cloud_spacing = 0;
   std::vector<TileInfo> tiles;
   std::vector<std::uint64_t> block_offset;
   std::vector<std::uint64_t> block_bytes;
@@ -129,6 +130,10 @@ void TileStore::Impl::open() {
   origin.content = load_le<std::uint64_t>(h + header::origin_content);
   origin.path = load_le<std::uint64_t>(h + header::origin_path);
   origin.tile_points = load_le<std::uint64_t>(h + header::origin_tile_points);
+  cloud_spacing = load_le<double>(h + header::cloud_spacing);
+  if (!(cloud_spacing >= 0) || !std::isfinite(cloud_spacing)) {
+    fail("header: cloud spacing {} is not a length", cloud_spacing);
+  }
   const auto table_offset = load_le<std::uint64_t>(h + header::table_offset);
   const auto table_bytes = load_le<std::uint64_t>(h + header::table_bytes);
   if (table_offset != kHeaderBytes || tile_count > size / kEntryBytes ||
@@ -281,6 +286,9 @@ const std::filesystem::path& TileStore::path() const {
 }
 const TileBox& TileStore::bounds() const {
   return impl_->bounds;
+}
+double TileStore::cloud_spacing() const {
+  return impl_->cloud_spacing;
 }
 std::span<const TileInfo> TileStore::tiles() const {
   return impl_->tiles;

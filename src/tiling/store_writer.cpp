@@ -442,6 +442,7 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
   }
 
   BlockScratch scratch;
+  std::vector<double> cloud_sample;
   std::vector<double> xyz(largest_round * 3);
   std::vector<Index> ids(largest_round);
   std::uint64_t written = 0;
@@ -469,11 +470,16 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
     }
     // The spacing estimates of the round's tiles, in parallel (each is a serial pass over its
     // tile); the blocks are then written one by one, each encoded in parallel.
-    std::vector<double> spacing(round_end - round_begin);
+    std::vector<TileSpacing> spacing(round_end - round_begin);
     tbb::parallel_for(round_begin, round_end, [&](std::size_t t) {
-      spacing[t - round_begin] = estimate_tile_spacing(
-          std::span<const double>(xyz.data() + 3 * (tile_start[t] - base), 3 * counts[leaves[t]]));
+      const std::size_t begin = tile_start[t] - base, n = counts[leaves[t]];
+      spacing[t - round_begin] = measure_tile_spacing(
+          std::span<const double>(xyz.data() + 3 * begin, 3 * n),
+          std::span<const Index>(ids.data() + begin, n), tree.box(leaves[t]), bounds, total);
     });
+    for (const TileSpacing& s : spacing) {
+      cloud_sample.insert(cloud_sample.end(), s.cloud_sample.begin(), s.cloud_sample.end());
+    }
     for (std::size_t t = round_begin; t < round_end; ++t) {
       const std::uint32_t node = leaves[t];
       const std::size_t begin = tile_start[t] - base;
@@ -488,7 +494,7 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
         store_le(e + entry::box + 24 + 8 * a, tree.box(node).hi[a]);
       }
       store_le(e + entry::points, std::uint64_t{n});
-      store_le(e + entry::spacing, spacing[t - round_begin]);
+      store_le(e + entry::spacing, spacing[t - round_begin].mean);
       store_le(e + entry::block_offset, block.offset);
       store_le(e + entry::block_bytes, block.bytes);
       store_le(e + entry::frame_table_checksum, block.frame_table_checksum);
@@ -525,6 +531,7 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
   store_le(h + header::origin_content, origin.content);
   store_le(h + header::origin_path, origin.path);
   store_le(h + header::origin_tile_points, origin.tile_points);
+  store_le(h + header::cloud_spacing, cloud_spacing(std::move(cloud_sample)));
   store_le(h + header::header_checksum, xxhash64(h, header::header_checksum));
   file.write_at(0, header.data(), header.size());
   file.write_at(kHeaderBytes, table.data(), table.size());

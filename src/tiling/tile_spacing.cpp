@@ -1,4 +1,4 @@
-// Tile spacing estimate (see tile_spacing.hpp): the points are bucketed by cell once; a sampled
+// Tile spacing estimates (see tile_spacing.hpp): the points are bucketed by cell once; a sampled
 // point's nearest neighbour is searched in shells of cells around its own, stopping
 // once the best distance found is within the searched cube, so the answer is exact.
 #include "tiling/tile_spacing.hpp"
@@ -10,10 +10,14 @@
 #include <limits>
 #include <vector>
 
+#include "common/mix64.hpp"
+
 namespace g2s::tiling {
 namespace {
 
 constexpr std::size_t kSamples = 4096;
+constexpr std::uint64_t kCloudSamples = 65536;
+constexpr double kSeamMargin = 4;
 constexpr std::int64_t kMaxShell = 16;
 constexpr std::int64_t kMaxCells = (std::int64_t{1} << 21) - 1;  // per axis: 21-bit keys
 
@@ -22,65 +26,55 @@ std::uint64_t cell_key(std::int64_t x, std::int64_t y, std::int64_t z) {
          static_cast<std::uint64_t>(z);
 }
 
-}  // namespace
-
-double estimate_tile_spacing(std::span<const double> xyz) {
-  const std::size_t n = xyz.size() / 3;
-  if (n < 2) return 0.0;
-  double lo[3], hi[3];
-  for (int a = 0; a < 3; ++a) lo[a] = hi[a] = xyz[a];
-  for (std::size_t i = 1; i < n; ++i) {
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::min(lo[a], xyz[3 * i + a]);
-      hi[a] = std::max(hi[a], xyz[3 * i + a]);
+// A tile's points bucketed by a hash of their cell, for exact nearest-neighbour searches.
+class NeighbourCells {
+ public:
+  explicit NeighbourCells(std::span<const double> xyz) : xyz_(xyz), n_(xyz.size() / 3) {
+    if (n_ < 2) return;
+    for (int a = 0; a < 3; ++a) lo_[a] = hi_[a] = xyz[a];
+    for (std::size_t i = 1; i < n_; ++i) {
+      for (int a = 0; a < 3; ++a) {
+        lo_[a] = std::min(lo_[a], xyz[3 * i + a]);
+        hi_[a] = std::max(hi_[a], xyz[3 * i + a]);
+      }
     }
-  }
-  const double dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
-  const double extent = std::max({dx, dy, dz});
-  if (!(extent > 0)) return 0.0;
-  // A surface sample: the area is of the order of the box's largest faces; a line has none.
-  const double area = dx * dy + dy * dz + dz * dx;
-  double cell = area > 0 ? 2.0 * std::sqrt(area / static_cast<double>(n))
-                         : 2.0 * extent / static_cast<double>(n);
-  cell = std::max(cell, extent / static_cast<double>(kMaxCells - 1));
-  const double inv_cell = 1.0 / cell;
-  auto coord = [&](double v, int a) {
-    return std::clamp<std::int64_t>(static_cast<std::int64_t>((v - lo[a]) * inv_cell), 0,
-                                    kMaxCells - 1);
-  };
-
-  // Points bucketed by a hash of their cell (a counting sort, O(n)). Cells sharing a bucket
-  // only add candidates: distances are computed exactly, so the answer is unchanged.
-  std::size_t buckets = 64;
-  while (buckets < 2 * n) buckets *= 2;
-  const int bucket_shift = 64 - std::countr_zero(buckets);
-  auto bucket_of = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
-    return static_cast<std::size_t>((cell_key(x, y, z) * 0x9E3779B97F4A7C15ull) >> bucket_shift);
-  };
-  std::vector<std::uint32_t> bucket_start(buckets + 1, 0);
-  std::vector<std::uint32_t> point_bucket(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const double* p = &xyz[3 * i];
-    point_bucket[i] =
-        static_cast<std::uint32_t>(bucket_of(coord(p[0], 0), coord(p[1], 1), coord(p[2], 2)));
-    ++bucket_start[point_bucket[i] + 1];
-  }
-  for (std::size_t b = 0; b < buckets; ++b) bucket_start[b + 1] += bucket_start[b];
-  std::vector<std::uint32_t> bucketed(n);
-  {
-    std::vector<std::uint32_t> fill(bucket_start.begin(), bucket_start.end() - 1);
-    for (std::size_t i = 0; i < n; ++i)
-      bucketed[fill[point_bucket[i]]++] = static_cast<std::uint32_t>(i);
+    const double dx = hi_[0] - lo_[0], dy = hi_[1] - lo_[1], dz = hi_[2] - lo_[2];
+    const double extent = std::max({dx, dy, dz});
+    if (!(extent > 0)) return;
+    // A surface sample: the area is of the order of the box's largest faces; a line has none.
+    const double area = dx * dy + dy * dz + dz * dx;
+    cell_ = area > 0 ? 2.0 * std::sqrt(area / static_cast<double>(n_))
+                     : 2.0 * extent / static_cast<double>(n_);
+    cell_ = std::max(cell_, extent / static_cast<double>(kMaxCells - 1));
+    inv_cell_ = 1.0 / cell_;
+    // Points bucketed by a hash of their cell (a counting sort, O(n)). Cells sharing a bucket
+    // only add candidates: distances are computed exactly, so the answer is unchanged.
+    std::size_t buckets = 64;
+    while (buckets < 2 * n_) buckets *= 2;
+    bucket_shift_ = 64 - std::countr_zero(buckets);
+    bucket_start_.assign(buckets + 1, 0);
+    std::vector<std::uint32_t> point_bucket(n_);
+    for (std::size_t i = 0; i < n_; ++i) {
+      const double* p = &xyz[3 * i];
+      point_bucket[i] =
+          static_cast<std::uint32_t>(bucket_of(coord(p[0], 0), coord(p[1], 1), coord(p[2], 2)));
+      ++bucket_start_[point_bucket[i] + 1];
+    }
+    for (std::size_t b = 0; b < buckets; ++b) bucket_start_[b + 1] += bucket_start_[b];
+    bucketed_.resize(n_);
+    std::vector<std::uint32_t> fill(bucket_start_.begin(), bucket_start_.end() - 1);
+    for (std::size_t i = 0; i < n_; ++i)
+      bucketed_[fill[point_bucket[i]]++] = static_cast<std::uint32_t>(i);
   }
 
-  const std::size_t step = (n + kSamples - 1) / kSamples;
-  double sum = 0.0;
-  std::size_t found = 0;
-  for (std::size_t s = 0; s < n; s += step) {
-    const double* p = &xyz[3 * s];
+  bool usable() const { return inv_cell_ > 0; }
+
+  // The distance from point i to its nearest distinct neighbour, exact, or infinity when none
+  // lies within kMaxShell cells (an outlier).
+  double nearest_distance(std::size_t i) const {
+    const double* p = &xyz_[3 * i];
     const std::int64_t c[3] = {coord(p[0], 0), coord(p[1], 1), coord(p[2], 2)};
     double best2 = std::numeric_limits<double>::infinity();
-    bool exact = false;
     for (std::int64_t r = 0; r <= kMaxShell; ++r) {
       for (std::int64_t x = c[0] - r; x <= c[0] + r; ++x) {
         for (std::int64_t y = c[1] - r; y <= c[1] + r; ++y) {
@@ -92,8 +86,8 @@ double estimate_tile_spacing(std::span<const double> xyz) {
               continue;
             }
             const std::size_t b = bucket_of(x, y, z);
-            for (std::uint32_t k = bucket_start[b]; k < bucket_start[b + 1]; ++k) {
-              const double* q = &xyz[3 * bucketed[k]];
+            for (std::uint32_t k = bucket_start_[b]; k < bucket_start_[b + 1]; ++k) {
+              const double* q = &xyz_[3 * bucketed_[k]];
               const double d2 = (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
                                 (p[2] - q[2]) * (p[2] - q[2]);
               if (d2 > 0 && d2 < best2) best2 = d2;
@@ -102,18 +96,76 @@ double estimate_tile_spacing(std::span<const double> xyz) {
         }
       }
       // Every point outside the searched cube is at least r cells away.
-      const double reach = static_cast<double>(r) * cell;
-      if (best2 <= reach * reach) {
-        exact = true;
-        break;
-      }
+      const double reach = static_cast<double>(r) * cell_;
+      if (best2 <= reach * reach) return std::sqrt(best2);
     }
-    if (exact) {
-      sum += std::sqrt(best2);
-      ++found;
-    }
+    return std::numeric_limits<double>::infinity();
   }
-  return found > 0 ? sum / static_cast<double>(found) : 0.0;
+
+ private:
+  std::int64_t coord(double v, int a) const {
+    return std::clamp<std::int64_t>(static_cast<std::int64_t>((v - lo_[a]) * inv_cell_), 0,
+                                    kMaxCells - 1);
+  }
+  std::size_t bucket_of(std::int64_t x, std::int64_t y, std::int64_t z) const {
+    return static_cast<std::size_t>((cell_key(x, y, z) * 0x9E3779B97F4A7C15ull) >> bucket_shift_);
+  }
+
+  std::span<const double> xyz_;
+  std::size_t n_;
+  double lo_[3] = {0, 0, 0}, hi_[3] = {0, 0, 0};
+  double cell_ = 0, inv_cell_ = 0;
+  int bucket_shift_ = 0;
+  std::vector<std::uint32_t> bucket_start_, bucketed_;
+};
+
+}  // namespace
+
+TileSpacing measure_tile_spacing(std::span<const double> xyz, std::span<const Index> ids,
+                                 const TileBox& box, const TileBox& bounds,
+                                 std::uint64_t cloud_points) {
+  TileSpacing out;
+  const std::size_t n = xyz.size() / 3;
+  const NeighbourCells cells(xyz);
+  if (!cells.usable()) return out;
+  const std::size_t step = (n + kSamples - 1) / kSamples;
+  double sum = 0.0;
+  std::size_t found = 0;
+  for (std::size_t s = 0; s < n; s += step) {
+    const double d = cells.nearest_distance(s);
+    if (d == std::numeric_limits<double>::infinity()) continue;
+    sum += d;
+    ++found;
+  }
+  out.mean = found > 0 ? sum / static_cast<double>(found) : 0.0;
+  // The cloud's sample, but the points within kSeamMargin tile spacings of a face of the box
+  // inside the cloud: whether a point is left out does not depend on its distance, so the
+  // median is not biased. A point kept has no nearer neighbour in another tile than in its own,
+  // or both are farther than the margin, far above the median.
+  const std::uint64_t threshold = cloud_points <= kCloudSamples
+                                      ? ~std::uint64_t{0}
+                                      : (~std::uint64_t{0} / cloud_points) * kCloudSamples;
+  const double margin = kSeamMargin * out.mean;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (mix64(ids[i]) > threshold) continue;  // by id: the same points in any tiling
+    bool inside = true;
+    for (int a = 0; a < 3 && inside; ++a) {
+      const double p = xyz[3 * i + a];
+      inside = (box.lo[a] <= bounds.lo[a] || p - box.lo[a] >= margin) &&
+               (box.hi[a] >= bounds.hi[a] || box.hi[a] - p >= margin);
+    }
+    if (!inside) continue;
+    const double d = cells.nearest_distance(i);
+    if (d != std::numeric_limits<double>::infinity()) out.cloud_sample.push_back(d);
+  }
+  return out;
+}
+
+double cloud_spacing(std::vector<double> sample) {
+  if (sample.empty()) return 0.0;
+  const auto middle = sample.begin() + static_cast<std::ptrdiff_t>(sample.size() / 2);
+  std::nth_element(sample.begin(), middle, sample.end());
+  return *middle;
 }
 
 }  // namespace g2s::tiling

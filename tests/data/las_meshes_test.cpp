@@ -66,12 +66,14 @@ TEST_F(LasMesh, AutzenLasAndPlyGiveTheSameMesh) {
     EXPECT_EQ(json_number(a, defect), json_number(b, defect)) << defect;
   }
   // Boundary edges, holes and components follow the triangles: ties broken differently by the float
-  // rounding may open or close a few, and a hole filled or not changes the count by one.
+  // rounding may open or close a few, and a hole filled or not changes the count by one. Growth
+  // is a chain of choices: moving the search radius cap by 0.5% moves autzen's holes over
+  // 194-210 (its boundary edges over 9,022-9,373), so the two roundings may differ by as much.
   const double ba = json_number(a, "boundary_edges");
   const double bb = json_number(b, "boundary_edges");
-  EXPECT_LE(std::abs(ba - bb), 0.01 * bb) << ba << " vs " << bb;
+  EXPECT_LE(std::abs(ba - bb), 0.02 * bb) << ba << " vs " << bb;
   EXPECT_LE(std::abs(json_number(a, "holes") - json_number(b, "holes")),
-            0.05 * json_number(b, "holes") + 2);
+            0.1 * json_number(b, "holes") + 2);
   // Small pieces at the scan's ragged edges come and go with the float rounding of either file.
   EXPECT_LE(std::abs(json_number(a, "components") - json_number(b, "components")),
             0.1 * json_number(b, "components") + 2);

@@ -293,6 +293,43 @@ TEST_F(TileStoreTest, DenseClusterGetsSmallerTiles) {
   EXPECT_LT(median(cluster_volumes) * 100, median(spread_volumes));
 }
 
+TEST_F(TileStoreTest, CloudSpacingIsTheMedianNearestNeighbourDistanceWhateverTheTiling) {
+  // 10k noisy torus points, no outliers: every point is in the cloud's sample.
+  g2s::SynthOptions options;
+  options.shape = g2s::SynthShape::torus;
+  options.points = 10'000;
+  options.noise = 0.3;
+  const fs::path input = dir_ / "torus.ply";
+  g2s::write_synthetic_cloud(input, options);
+  const g2s::PointCloud cloud = g2s::read_points(input);
+  // The median of the exact nearest-neighbour distances, by brute force (the upper median, as
+  // the library takes it).
+  std::vector<double> nearest(cloud.size(), std::numeric_limits<double>::infinity());
+  tbb::parallel_for(std::size_t{0}, cloud.size(), [&](std::size_t i) {
+    for (std::size_t j = 0; j < cloud.size(); ++j) {
+      double d2 = 0;
+      for (int a = 0; a < 3; ++a) d2 += std::pow(cloud.xyz[3 * i + a] - cloud.xyz[3 * j + a], 2);
+      if (d2 > 0) nearest[i] = std::min(nearest[i], std::sqrt(d2));
+    }
+  });
+  const auto middle = nearest.begin() + static_cast<std::ptrdiff_t>(nearest.size() / 2);
+  std::nth_element(nearest.begin(), middle, nearest.end());
+  const double expected = *middle;
+  const g2s::TileStore whole(build(input, "whole.tiles", 1u << 20, false));
+  ASSERT_EQ(whole.tiles().size(), 1u);
+  EXPECT_NEAR(whole.cloud_spacing(), expected, 1e-12 * expected);
+  EXPECT_EQ(g2s::MemoryTiles(cloud, 1u << 20).cloud_spacing(), whole.cloud_spacing());
+  // In tiles, the points whose neighbour may lie in another tile are left out of the sample:
+  // the median moves by a fraction of a percent, where the tiles' own spacings spread widely.
+  for (const std::uint64_t tile_points : {2000u, 500u}) {
+    const g2s::TileStore store(
+        build(input, fmt::format("t{}.tiles", tile_points), tile_points, tile_points == 500u));
+    EXPECT_GE(store.tiles().size(), 10'000 / tile_points);
+    EXPECT_NEAR(store.cloud_spacing(), expected, 0.01 * expected) << tile_points;
+    EXPECT_EQ(g2s::MemoryTiles(cloud, tile_points).cloud_spacing(), store.cloud_spacing());
+  }
+}
+
 TEST_F(TileStoreTest, LastTileOfTheSweepIsSplitSmall) {
   // Tiles grow in parallel in sweep order (store order), so the last one is grown while the
   // other threads run out of work: it is split down to a quarter of the budget. A cloud that
@@ -538,10 +575,10 @@ TEST_F(TileStoreDamage, Truncated) {
 
 TEST_F(TileStoreDamage, VersionMagicAndEmptyFile) {
   std::string newer = bytes_;
-  newer[8] = 3;
+  newer[8] = 4;
   const fs::path path = damaged(newer);
   expect_error([&] { g2s::TileStore s(path); }, Exit::bad_input,
-               {"store version 3, this g2s reads 2"});
+               {"store version 4, this g2s reads 3"});
   const fs::path ply = dir_ / "sphere.ply";
   expect_error([&] { g2s::TileStore s(ply); }, Exit::bad_input,
                {ply.string() + ": ", "not a g2s tile store"});
