@@ -515,6 +515,23 @@ class TileStoreDamage : public TileStoreTest {
   std::string bytes_;
 };
 
+// A header whose checksum holds but whose cloud spacing is no length (a writer's bug, or a
+// crafted file): refused by name, never used as a search radius.
+TEST_F(TileStoreDamage, CloudSpacingThatIsNoLength) {
+  namespace header = g2s::tiling::header;
+  EXPECT_GT(g2s::TileStore(store_).cloud_spacing(), 0.0);
+  for (const double spacing :
+       {std::numeric_limits<double>::quiet_NaN(), -1.0, std::numeric_limits<double>::infinity()}) {
+    std::string bad = bytes_;
+    std::memcpy(bad.data() + header::cloud_spacing, &spacing, sizeof spacing);
+    const std::uint64_t checksum = g2s::tiling::xxhash64(bad.data(), header::header_checksum);
+    std::memcpy(bad.data() + header::header_checksum, &checksum, sizeof checksum);
+    const fs::path path = damaged(bad);
+    expect_error([&] { g2s::TileStore s(path); }, Exit::bad_input,
+                 {path.string() + ": ", "cloud spacing"});
+  }
+}
+
 TEST_F(TileStoreDamage, FlippedHeaderByte) {
   const fs::path path = damaged(flipped(24));  // the point count
   expect_error([&] { g2s::TileStore s(path); }, Exit::bad_input,
