@@ -143,14 +143,9 @@ class SeamStitcher {
 
     MeshOptions mesh_options = options_.mesh;
     mesh_options.progress = {};
-    GrowResult grown = grow_mesh(grid, mesh_options,
-                                 {preload_,
-                                  preload_group_,
-                                  growable,
-                                  links_,
-                                  options_.stitch_retries,
-                                  {},
-                                  source_.cloud_spacing()});
+    GrowContext context{preload_, preload_group_, growable, links_, options_.stitch_retries, {}};
+    context.cloud_spacing = source_.cloud_spacing();
+    GrowResult grown = grow_mesh(grid, mesh_options, context);
 
     // Orientation: per grower group, the first preloaded triangle anchors it to a live group.
     const std::size_t preloaded = preload_.size();

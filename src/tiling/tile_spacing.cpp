@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "common/mix64.hpp"
+#include "tiling/store_format.hpp"
 
 namespace g2s::tiling {
 namespace {
@@ -146,15 +147,10 @@ TileSpacing measure_tile_spacing(std::span<const double> xyz, std::span<const In
                                       ? ~std::uint64_t{0}
                                       : (~std::uint64_t{0} / cloud_points) * kCloudSamples;
   const double margin = kSeamMargin * out.mean;
+  const BorderFaces faces(box, bounds);
   for (std::size_t i = 0; i < n; ++i) {
     if (mix64(ids[i]) > threshold) continue;  // by id: the same points in any tiling
-    bool inside = true;
-    for (int a = 0; a < 3 && inside; ++a) {
-      const double p = xyz[3 * i + a];
-      inside = (box.lo[a] <= bounds.lo[a] || p - box.lo[a] >= margin) &&
-               (box.hi[a] >= bounds.hi[a] || box.hi[a] - p >= margin);
-    }
-    if (!inside) continue;
+    if (faces.distance(&xyz[3 * i]) < margin) continue;
     const double d = cells.nearest_distance(i);
     if (d != std::numeric_limits<double>::infinity()) out.cloud_sample.push_back(d);
   }

@@ -1,7 +1,7 @@
 // The sampling spacing of one tile, stored in the tile table so that a pipeline stage can size
 // its halo and its grid before loading any points, and the tile's part of the whole cloud's
 // spacing, stored in the header: the mesher's search radius never falls below what the cloud's
-// spacing allows, whatever the tiling (docs/algorithm.md, "Search radius").
+// spacing allows, whatever the tiling (docs/algorithm.md, "Search balls").
 #pragma once
 
 #include <cstdint>
