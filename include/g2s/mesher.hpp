@@ -20,8 +20,9 @@ struct MeshOptions {
   int flatness_levels = 4;
   // A new triangle whose normal turns more than this from its front neighbour's is a fold.
   double max_fold_deg = 135.0;
-  // No search ball is larger than this many spacings (the median nearest-neighbour distance):
-  // fronts do not bridge voids, and a query never scans a large part of the cloud.
+  // No search ball is larger than this many spacings (the median nearest-neighbour distance; in
+  // the tiled pipeline the whole cloud's, or a tile's where provably larger): fronts do not
+  // bridge voids, and a query never scans a large part of the cloud.
   double max_radius = 6.0;
   // Seed search ball radius, in nearest-neighbour edge lengths (docs/algorithm.md §2).
   double seed_ball = 2.5;

@@ -75,7 +75,7 @@ HashGrid::HashGrid(std::span<const float> xyz, std::span<const Index> ids) {
   const double min_cell = extent > 0 ? extent / static_cast<double>(kMaxDim) : 1.0;
 
   build(xyz, ids, std::max(cell, min_cell));
-  spacing_ = estimate_spacing();
+  estimate_spacing();
   // Rebuild with a cell edge of about three spacings: a front search ball (radius about one edge,
   // which on noisy scans is often twice the nearest-neighbour distance) then spans about two
   // cells per axis, and a cell holds about ten surface points, scanned sequentially. Always
@@ -167,9 +167,10 @@ void HashGrid::build(std::span<const float> xyz, std::span<const Index> ids, dou
   }
 }
 
-double HashGrid::estimate_spacing() const {
+void HashGrid::estimate_spacing() {
+  spacing_ = spacing_lower_bound_ = 0.0;
   const std::uint32_t n = size();
-  if (n < 2) return 0.0;
+  if (n < 2) return;
   // Samples are chosen by a hash of their coordinates, not their place in the grid order, so
   // the estimate does not depend on the first cell size. A point with no neighbour within 64
   // cells is an outlier and is left out rather than searched for across empty space.
@@ -188,10 +189,19 @@ double HashGrid::estimate_spacing() const {
     const std::uint32_t j = nearest(i, max_radius, [](std::uint32_t) { return true; });
     if (j != kNoIndex) d.push_back(std::sqrt(norm2(position(i) - position(j))));
   }
-  if (d.empty()) return 0.0;
+  if (d.empty()) return;
   // The median: robust to outliers and to the few isolated points every scan has.
-  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
-  return d[d.size() / 2];
+  const std::size_t middle = d.size() / 2;
+  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(middle), d.end());
+  spacing_ = d[middle];
+  // The number of sampled distances below the true median is binomial (m, 1/2): it falls under
+  // m/2 - 1.96 sqrt(m)/2 with probability 2.5% (normal approximation).
+  const double half_width = 0.98 * std::sqrt(static_cast<double>(d.size()));
+  const auto lower =
+      static_cast<std::size_t>(std::max(0.0, std::floor(static_cast<double>(middle) - half_width)));
+  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(lower),
+                   d.begin() + static_cast<std::ptrdiff_t>(middle));
+  spacing_lower_bound_ = d[lower];
 }
 
 }  // namespace g2s

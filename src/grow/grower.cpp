@@ -80,7 +80,10 @@ class Grower {
         max_fold_(options.max_fold_deg * std::numbers::pi / 180.0),
         cos_max_fold_(std::cos(max_fold_)),
         radius_floor_(0.5 * grid.spacing()),
-        radius_cap_(options.max_radius * std::max(grid.spacing(), context.cloud_spacing)) {
+        radius_cap_(options.max_radius *
+                    (context.cloud_spacing > 0
+                         ? std::max(grid.spacing_lower_bound(), context.cloud_spacing)
+                         : grid.spacing())) {
     // Noisy scans grow up to about three triangles a point before the clean-up; reserving more
     // costs only address space (pages are touched as triangles come) and saves copying.
     const std::size_t expected = std::size_t{4} * grid.size();

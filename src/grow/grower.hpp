@@ -32,8 +32,11 @@ struct GrowContext {
   // out of every seam's reach: holes nearer a seam are the seam's); empty: every growable one.
   std::span<const std::uint8_t> fillable;
   // The whole cloud's spacing (a tile's or a seam's grid sees only part of it), or 0: the
-  // search radius is capped at max_radius times the larger of it and the grid's own spacing,
-  // so that a region denser than the cloud bridges the gaps the cloud's sampling leaves.
+  // search radius is capped at max_radius times the larger of it and the lower confidence bound
+  // of the grid's own spacing (HashGrid::spacing_lower_bound), so that a region denser than the
+  // cloud bridges the gaps the cloud's sampling leaves, a sparser one reaches as far as its own
+  // sampling needs, and a grid whose sampled spacing only seems larger does not reach farther
+  // (one tile and many then cap alike). With 0, the cap is the grid's own spacing.
   double cloud_spacing = 0;
 };
 

@@ -469,6 +469,37 @@ TEST(HashGrid, SpacingIsWithinTenPercentOfTheMedianNearestNeighbourDistance) {
   }
 }
 
+// Under 4,096 points every point is sampled: the spacing is the median of all nearest-neighbour
+// distances, and its lower bound the order statistic m/2 - 1.96 sqrt(m)/2 of them.
+TEST(HashGrid, SpacingLowerBoundIsAnOrderStatisticBelowTheMedian) {
+  std::mt19937_64 rng(5);
+  for (const Cloud& cloud : {sphere_surface(rng, 3000), flat_plane(rng, 1000)}) {
+    const HashGrid grid(cloud.xyz, {});
+    std::vector<double> nn;  // computed as the grid computes them
+    for (std::uint32_t i = 0; i < grid.size(); ++i) {
+      double best = INFINITY;
+      for (std::uint32_t j = 0; j < grid.size(); ++j) {
+        if (j != i) best = std::min(best, norm2(grid.position(i) - grid.position(j)));
+      }
+      nn.push_back(std::sqrt(best));
+    }
+    std::sort(nn.begin(), nn.end());
+    const std::size_t m = nn.size();
+    const auto lower = static_cast<std::size_t>(
+        std::floor(static_cast<double>(m / 2) - 0.98 * std::sqrt(static_cast<double>(m))));
+    EXPECT_EQ(grid.spacing(), nn[m / 2]) << cloud.name;
+    EXPECT_EQ(grid.spacing_lower_bound(), nn[lower]) << cloud.name;
+    EXPECT_LT(grid.spacing_lower_bound(), grid.spacing()) << cloud.name;
+  }
+  // Every distance equal (a lattice): no spread, the bound is the spacing.
+  Cloud lattice{"lattice", {}};
+  for (int j = 0; j < 50; ++j) {
+    for (int i = 0; i < 50; ++i) push(lattice, i * 0.5, j * 0.5, 0.0);
+  }
+  const HashGrid grid(lattice.xyz, {});
+  EXPECT_EQ(grid.spacing_lower_bound(), grid.spacing());
+}
+
 // Builds the grid, then checks ball queries (radius 0, a few spacings, larger than the cloud) and
 // the nearest neighbour of every 50th point against brute force. "" when all agree.
 std::string check_grid_against_brute_force(const Cloud& cloud) {
