@@ -76,23 +76,26 @@ class NeighbourCells {
     const double* p = &xyz_[3 * i];
     const std::int64_t c[3] = {coord(p[0], 0), coord(p[1], 1), coord(p[2], 2)};
     double best2 = std::numeric_limits<double>::infinity();
+    const auto visit = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
+      if (x < 0 || y < 0 || z < 0 || x >= kMaxCells || y >= kMaxCells || z >= kMaxCells) return;
+      const std::size_t b = bucket_of(x, y, z);
+      for (std::uint32_t k = bucket_start_[b]; k < bucket_start_[b + 1]; ++k) {
+        const double* q = &xyz_[3 * bucketed_[k]];
+        const double d2 = (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+                          (p[2] - q[2]) * (p[2] - q[2]);
+        if (d2 > 0 && d2 < best2) best2 = d2;
+      }
+    };
     for (std::int64_t r = 0; r <= kMaxShell; ++r) {
+      // The cells of shell r only (the cube's surface): an outlier's search, 16 shells deep,
+      // visits 36k cells instead of walking the whole cube of each shell (167k).
       for (std::int64_t x = c[0] - r; x <= c[0] + r; ++x) {
         for (std::int64_t y = c[1] - r; y <= c[1] + r; ++y) {
-          for (std::int64_t z = c[2] - r; z <= c[2] + r; ++z) {
-            const std::int64_t shell =
-                std::max({std::abs(x - c[0]), std::abs(y - c[1]), std::abs(z - c[2])});
-            if (shell != r || x < 0 || y < 0 || z < 0 || x >= kMaxCells || y >= kMaxCells ||
-                z >= kMaxCells) {
-              continue;
-            }
-            const std::size_t b = bucket_of(x, y, z);
-            for (std::uint32_t k = bucket_start_[b]; k < bucket_start_[b + 1]; ++k) {
-              const double* q = &xyz_[3 * bucketed_[k]];
-              const double d2 = (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
-                                (p[2] - q[2]) * (p[2] - q[2]);
-              if (d2 > 0 && d2 < best2) best2 = d2;
-            }
+          if (std::abs(x - c[0]) == r || std::abs(y - c[1]) == r) {
+            for (std::int64_t z = c[2] - r; z <= c[2] + r; ++z) visit(x, y, z);
+          } else {
+            visit(x, y, c[2] - r);
+            visit(x, y, c[2] + r);
           }
         }
       }
