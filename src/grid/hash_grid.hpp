@@ -35,8 +35,8 @@ class HashGrid {
   std::uint64_t duplicates_merged() const { return duplicates_; }
   double spacing() const { return spacing_; }  // median nearest-neighbour distance (sampled)
   // A lower 95% confidence bound of that median: the sample's order statistic of rank
-  // m/2 - 1.96 sqrt(m)/2 (m distances), below which the true median lies with probability at most
-  // 2.5% whatever their distribution. 0 where spacing() is.
+  // m/2 - 1.96 sqrt(m)/2 (m distances), above the true median with probability about 2.5%
+  // whatever their distribution (the count below the median is binomial). 0 where spacing() is.
   double spacing_lower_bound() const { return spacing_lower_bound_; }
   double cell_size() const { return cell_; }
 
