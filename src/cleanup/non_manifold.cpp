@@ -5,6 +5,7 @@
 // deleted. Deleting can split a fan at the deleted triangles' other corners, so those go back on
 // a worklist. Each deletion is final, so the total work is linear in the mesh size.
 #include <algorithm>
+#include <bit>
 #include <functional>
 #include <memory>
 #include <numeric>
@@ -121,11 +122,22 @@ NonManifoldReport mark_non_manifold_fans(std::span<const Triangle> triangles,
   if (suspects.empty()) return report;
   Stars stars(triangles, vertex_count, suspects.size());
   // Suspects are examined in index order whatever order they arose in.
+  // The work list is popped from the back, so it runs from the largest index down. Suspects
+  // come with many repeats (every corner of every removed triangle): where sorting them would
+  // cost more than reading a flag per vertex, the flags put them in order.
   std::vector<std::uint8_t> queued(vertex_count, 0);
-  std::vector<Index> work(suspects.begin(), suspects.end());
-  std::sort(work.begin(), work.end(), std::greater<Index>());  // popped from the back
-  work.erase(std::unique(work.begin(), work.end()), work.end());
-  for (Index v : work) queued[v] = 1;
+  std::vector<Index> work;
+  if (suspects.size() * std::bit_width(suspects.size()) > vertex_count) {
+    for (const Index v : suspects) queued[v] = 1;
+    for (std::size_t v = vertex_count; v-- > 0;) {
+      if (queued[v]) work.push_back(static_cast<Index>(v));
+    }
+  } else {
+    work.assign(suspects.begin(), suspects.end());
+    std::sort(work.begin(), work.end(), std::greater<Index>());
+    work.erase(std::unique(work.begin(), work.end()), work.end());
+    for (const Index v : work) queued[v] = 1;
+  }
 
   // Scratch for one star.
   std::vector<Corner> tris;

@@ -236,11 +236,23 @@ Pairs TriangleCells::crossing_pairs() const {
 }
 
 void TriangleCells::build(Level& level, std::span<const std::uint32_t> members) {
-  const auto key_of = [&](const Box& box) {
-    return key(level.coord(box.lo.x), level.coord(box.lo.y), level.coord(box.lo.z));
-  };
   const auto home = [&](std::uint64_t k) {
     return static_cast<std::size_t>((k * 0x9E3779B97F4A7C15ull) >> level.shift);
+  };
+  // Each member's cell key, worked out once. Both passes below look the keys up in the table,
+  // whose slots are scattered over memory (megabytes on a large tile): the slot of the member
+  // kAhead places on is loaded while this one is placed.
+  constexpr std::size_t kAhead = 16;
+  std::vector<std::uint64_t> member_keys(members.size());
+  for (std::size_t i = 0; i < members.size(); ++i) {
+    const Box box = box_of(points_, triangles_[members[i]]);
+    member_keys[i] = key(level.coord(box.lo.x), level.coord(box.lo.y), level.coord(box.lo.z));
+  }
+  const auto load_ahead = [&](std::size_t i) {
+    if (i + kAhead >= members.size()) return;
+    const std::size_t s = home(member_keys[i + kAhead]);
+    __builtin_prefetch(&level.keys[s]);
+    __builtin_prefetch(&level.end[s]);
   };
   // The cells and their counts, the table doubled whenever it would be more than half full.
   std::size_t cells = 0;
@@ -252,8 +264,9 @@ void TriangleCells::build(Level& level, std::span<const std::uint32_t> members) 
     while (level.keys[s] != kEmpty && level.keys[s] != k) s = (s + 1) & (level.keys.size() - 1);
     return s;
   };
-  for (const std::uint32_t t : members) {
-    const std::uint64_t k = key_of(box_of(points_, triangles_[t]));
+  for (std::size_t i = 0; i < members.size(); ++i) {
+    load_ahead(i);
+    const std::uint64_t k = member_keys[i];
     std::size_t s = slot_for(k);
     if (level.keys[s] == kEmpty) {
       if (2 * (cells + 1) > level.keys.size()) {
@@ -287,11 +300,12 @@ void TriangleCells::build(Level& level, std::span<const std::uint32_t> members) 
   level.begin[slots] = offset;
   level.filed.resize(members.size());
   level.boxes.resize(members.size());
-  for (const std::uint32_t t : members) {
-    const Box box = box_of(points_, triangles_[t]);
-    const std::uint32_t at = level.end[level.find(key_of(box))]++;
+  for (std::size_t i = 0; i < members.size(); ++i) {
+    load_ahead(i);
+    const std::uint32_t t = members[i];
+    const std::uint32_t at = level.end[level.find(member_keys[i])]++;
     level.filed[at] = t;
-    level.boxes[at] = box;
+    level.boxes[at] = box_of(points_, triangles_[t]);
   }
 }
 
