@@ -27,7 +27,8 @@ struct LiveMesh {
   static constexpr std::uint8_t kSuspect = 2;  // may have more than one fan
   static constexpr std::uint8_t kInBand = 4;   // scratch of the seam being stitched
   static constexpr std::uint8_t kReleased = 8;
-  static constexpr std::uint8_t kUnlisted = 16;  // not in slot_of: no seam will look it up
+  static constexpr std::uint8_t kUnlisted = 16;   // not in slot_of: no seam will look it up
+  static constexpr std::uint8_t kInContext = 32;  // scratch of the seam being stitched
 
   IdMap slot_of;  // global id -> slot
   std::vector<Index> id;

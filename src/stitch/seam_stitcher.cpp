@@ -5,7 +5,8 @@
 // those seams, with every live triangle that touches those points loaded into the Point-Edge Map:
 // their open edges are the front, and no new triangle can give an edge a third triangle or a vertex
 // a crossing fan the clean-up cannot see. Points farther out are loaded as context, so the Gabriel
-// test sees the whole neighbourhood, but are not used.
+// test sees the whole neighbourhood, but are not used; the live triangles touching only context
+// points are loaded too, so that no new triangle crosses one of them.
 //
 // Memory: only the live mesh is kept (stitch/live_mesh.hpp). After each tile the points no later
 // seam can reach are finished and the triangles around them released to the sink
@@ -74,11 +75,12 @@ class SeamStitcher {
       const auto next = static_cast<std::uint32_t>(ids_.size());
       const std::uint32_t at = local_of_.insert(id, next);
       if (at != next) return at;
-      // A band point is live (within the tile's reach, so not finished): flag it for the preload.
-      const std::uint32_t s = in_band ? live.slot(id) : IdMap::kMissing;
-      if (s != IdMap::kMissing) live.flags[s] |= LiveMesh::kInBand;
+      // A band point is live (within the tile's reach, so not finished); a context point may be.
+      // Either is flagged for the preload.
+      const std::uint32_t s = live.slot(id);
+      if (s != IdMap::kMissing) live.flags[s] |= in_band ? LiveMesh::kInBand : LiveMesh::kInContext;
       ids_.push_back(id);
-      growable_.push_back(s != IdMap::kMissing);
+      growable_.push_back(in_band && s != IdMap::kMissing);
       frame.append(p, local_);
       return at;
     };
@@ -97,14 +99,16 @@ class SeamStitcher {
         if (d <= reach.context) take(border.ids[k], j < tile && d <= band, &border.xyz[3 * k]);
       }
     }
-    // Every live triangle touching the band, presented facing as its group currently does, so
-    // the grower starts from what earlier seams already decided; in the order they were made.
+    // Every live triangle touching the band or its context, presented facing as its group currently
+    // does, so the grower starts from what earlier seams already decided; in the order they were
+    // made.
     preload_.clear();
     preload_group_.clear();
     preload_live_.clear();
     for (std::size_t t = 0; t < live.triangles.size(); ++t) {
       const Triangle& tri = live.triangles[t];
-      if (!((live.flags[tri[0]] | live.flags[tri[1]] | live.flags[tri[2]]) & LiveMesh::kInBand)) {
+      if (!((live.flags[tri[0]] | live.flags[tri[1]] | live.flags[tri[2]]) &
+            (LiveMesh::kInBand | LiveMesh::kInContext))) {
         continue;
       }
       const auto [root, parity] = live.groups.find(live.group[t]);
@@ -119,8 +123,9 @@ class SeamStitcher {
       preload_group_.push_back(root);
       preload_live_.push_back(static_cast<std::uint32_t>(t));
     }
-    for (std::size_t k = 0; k < ids_.size(); ++k) {
-      if (growable_[k]) live.flags[live.slot(ids_[k])] &= ~LiveMesh::kInBand;
+    for (const Index id : ids_) {
+      const std::uint32_t s = live.slot(id);
+      if (s != IdMap::kMissing) live.flags[s] &= ~(LiveMesh::kInBand | LiveMesh::kInContext);
     }
 
     const HashGrid grid(local_, ids_);
@@ -224,6 +229,9 @@ class SeamStitcher {
     normal_.assign(n, Vec3{0, 0, 0});
     for (std::size_t k = 0; k < preload_.size(); ++k) {
       const Triangle& t = preload_[k];
+      // Only the triangles at the band vote (those touching only context are there for the
+      // crossing test).
+      if (!growable[t[0]] && !growable[t[1]] && !growable[t[2]]) continue;
       const Vec3 a = grid.position(t[0]);
       const Vec3 area = cross(grid.position(t[1]) - a, grid.position(t[2]) - a);
       for (Index v : t) {

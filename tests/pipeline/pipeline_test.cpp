@@ -90,6 +90,32 @@ TEST(Pipeline, TorusCutIntoTilesIsClosedManifoldAndOriented) {
   EXPECT_GE(s.coverage, 0.999);
 }
 
+// A seam's new triangles may reach past the band to live triangles that touch no band point
+// (on very noisy clouds, long triangles near the band's edge): the stitcher loads every live
+// triangle within the seam's context, so that the seam's crossing test sees them. Before, these
+// clouds came out with a crossing pair each at these tile sizes.
+TEST(Pipeline, SeamTrianglesCrossNoLiveTriangleOnVeryNoisyClouds) {
+  struct Case {
+    g2s::SynthShape shape;
+    std::uint64_t points, seed, tile_points;
+  };
+  for (const Case& c : {Case{g2s::SynthShape::torus, 10000, 1, 500},
+                        Case{g2s::SynthShape::uneven, 20000, 3, 3000}}) {
+    g2s::SynthOptions o;
+    o.shape = c.shape;
+    o.points = c.points;
+    o.noise = 2;
+    o.seed = c.seed;
+    const g2s::PointCloud cloud = g2s::make_synthetic_cloud(o);
+    const g2s::MemoryTiles tiles(cloud, c.tile_points);
+    ASSERT_GE(tiles.tiles().size(), 8u);
+    const g2s::PipelineMesh mesh = g2s::mesh_tiles(tiles, {});
+    const g2s::MeshStats s = stats_of(cloud, mesh);
+    print("noisy cloud in small tiles", s, mesh);
+    expect_clean(s);
+  }
+}
+
 // predict_peak_live_points, which g2s mesh sizes the seams' band by under a tight budget, reads
 // the tiles before any grows: it must come close to what the stitcher then holds, from below
 // (it leaves out the few points held only as corners of triangles not yet final). Measured on
