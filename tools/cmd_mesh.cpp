@@ -84,8 +84,7 @@ void run_mesh(MeshArgs& args) {
   if (store_path.empty()) {
     const std::filesystem::path output(args.out.output);
     temporary = std::make_unique<TemporaryPath>(
-        output.parent_path() /
-        fmt::format(".{}.store-{}", output.filename().string(), static_cast<long>(getpid())));
+        hidden_beside(output, fmt::format("store-{}", static_cast<long>(getpid()))));
     store_path = temporary->path();
     run.output_written = [&temporary] { temporary.reset(); };
     run.temporary_store = store_path.string();

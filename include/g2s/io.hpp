@@ -9,6 +9,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "g2s/mesh_sink.hpp"
@@ -61,6 +62,12 @@ MeshFormat mesh_format_for(const std::filesystem::path& path, bool ascii_stl);
 // Makes SIGINT and SIGTERM remove every open AtomicFile's temporary, print a message and exit
 // with Exit::interrupted (130). For programs; a library user may keep its own handlers.
 void install_interrupt_cleanup();
+
+// The path of a hidden file beside `target` for one of its run's temporaries:
+// ".<target's name>.<tag>" in the same folder, the name cut short where the whole would pass the
+// file system's 255-byte limit on a name (so a legal target name never makes its temporary's
+// illegal). `tag` tells the temporaries apart (a kind, the process id, a counter).
+std::filesystem::path hidden_beside(const std::filesystem::path& target, std::string_view tag);
 
 // A file that exists only while a run needs it (the temporary tile store of `g2s mesh`):
 // removed when destroyed, and by the interrupt handler.

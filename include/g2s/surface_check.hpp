@@ -29,7 +29,8 @@ using PointVisitor = std::function<void(const PointRun&)>;
 std::string why_no_surface(std::uint64_t n, const PointVisitor& each);
 
 // The part of that check a bounding box answers (the tile store asks it before writing): why
-// points in [lo, hi] are beyond float's range, or "".
+// points in [lo, hi] are beyond float's range (wider than 1e38, or narrower than 1e-30 along
+// every axis but not a single point), or "".
 std::string why_beyond_float(const double lo[3], const double hi[3]);
 
 }  // namespace g2s

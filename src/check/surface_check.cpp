@@ -24,6 +24,11 @@ constexpr std::uint64_t kFewestOnLineWithStray = 10;
 
 // Widest extent along an axis that float (up to 3.4e38) holds with room to spare.
 constexpr double kWidestSpan = 1e38;
+// Narrowest extent of a cloud (along its widest axis) that float holds with room to spare: below
+// float's normal numbers (1.2e-38) coordinates keep fewer than 24 bits, down to one bit at 1e-45,
+// so the mesher's float frame would round neighbours together. At 1e-30 a float step (at most
+// 1.4e-45 there) is still below a millionth of the spacing of a cloud of up to 1e18 points.
+constexpr double kNarrowestSpan = 1e-30;
 
 double distance2(const Point& a, const Point& b) {
   const double dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
@@ -114,6 +119,13 @@ std::string why_beyond_float(const double lo[3], const double hi[3]) {
           "works in (a wild coordinate?)",
           hi[axis] - lo[axis], "xyz"[axis]);
     }
+  }
+  const double widest = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+  if (widest > 0 && widest < kNarrowestSpan) {
+    return fmt::format(
+        "the points span at most {:.3g} along any axis, too small for the float coordinates the "
+        "mesher works in (below {:.0e} they lose precision; scale the coordinates up)",
+        widest, kNarrowestSpan);
   }
   return "";
 }

@@ -47,6 +47,14 @@ std::filesystem::path follow_links(const std::filesystem::path& path) {
 
 }  // namespace
 
+std::filesystem::path hidden_beside(const std::filesystem::path& target, std::string_view tag) {
+  constexpr std::size_t kNameMax = 255;  // bytes in a name on Linux's file systems
+  std::string name = target.filename().string();
+  const std::size_t room = kNameMax - std::min(kNameMax, tag.size() + 2);  // "." name "." tag
+  if (name.size() > room) name.resize(room);
+  return target.parent_path() / fmt::format(".{}.{}", name, tag);
+}
+
 AtomicFile::AtomicFile(const std::filesystem::path& target) : target_(target) {
   const std::string name = target_.filename().string();
   if (name.empty() || name == "." || name == "..") {
@@ -64,8 +72,8 @@ AtomicFile::AtomicFile(const std::filesystem::path& target) : target_(target) {
                               target_.string()));
     }
   }
-  temporary_ = destination_.parent_path() /
-               fmt::format(".{}.tmp-{}-{}", name, static_cast<long>(::getpid()), g_counter++);
+  temporary_ = hidden_beside(destination_,
+                             fmt::format("tmp-{}-{}", static_cast<long>(::getpid()), g_counter++));
   // Registered before it exists, so a signal arriving just after it appears still removes it.
   registry_slot_ = register_temporary(temporary_.c_str());
   fd_ = ::open(temporary_.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0666);

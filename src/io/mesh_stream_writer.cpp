@@ -34,9 +34,7 @@ constexpr std::size_t kBufferSize = 1u << 20;
 class SpillFile {
  public:
   SpillFile(const std::filesystem::path& target, const char* kind)
-      : target_(target),
-        path_(target.parent_path() /
-              fmt::format(".{}.{}-{}", target.filename().string(), kind, ::getpid())) {
+      : target_(target), path_(hidden_beside(target, fmt::format("{}-{}", kind, ::getpid()))) {
     fd_ = ::open(path_.path().c_str(), O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
     if (fd_ < 0) fail("cannot create a spill file");
     buffer_.reserve(kBufferSize);

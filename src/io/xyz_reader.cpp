@@ -6,6 +6,7 @@
 // a time when streaming to a sink (so memory holds one batch whatever the file size).
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <optional>
@@ -115,6 +116,15 @@ PointCloud read_xyz_points(const MappedFile& file, ReadReport& report, const Poi
   report.declared = 0;
   std::string_view text = file.view();
   if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 byte order mark
+  // Classic Mac OS text ends its lines with CR alone: read as one line it would give one point
+  // and ignore the rest as extra columns. A file with CRs and no LF at all is read from a copy
+  // with LF line ends (of the same length, so file offsets stay as they are).
+  std::string lf_copy;
+  if (text.find('\r') != std::string_view::npos && text.find('\n') == std::string_view::npos) {
+    lf_copy.assign(text);
+    std::replace(lf_copy.begin(), lf_copy.end(), '\r', '\n');
+    text = lf_copy;
+  }
 
   // The first data line may be a PTS point count or a CSV line of column names.
   std::uint64_t line_before = 0;

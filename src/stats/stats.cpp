@@ -13,6 +13,7 @@
 #include <limits>
 #include <new>
 #include <numeric>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -475,6 +476,31 @@ void measure_stars(Table<Triangle>& triangles, std::size_t vertex_count, const T
       points == 0 ? 0.0 : static_cast<double>(stats.covered_points) / static_cast<double>(points);
 }
 
+// The exact predicates behind the crossing count hold while products of coordinate differences
+// stay in double's normal range: coordinates of extreme magnitude (an axis whose largest is
+// below 2^-100, such as subnormal ones, or above 2^100) make them underflow or overflow and
+// answer wrongly. Scaling an axis by a power of two is exact and changes the sign of no
+// orientation or the answer of no comparison, so such axes are scaled to a largest magnitude in
+// [0.5, 1), in a copy. Empty when no axis needs it (every real scan).
+std::vector<double> scaled_for_predicates(std::span<const double> xyz) {
+  double largest[3] = {0, 0, 0};
+  for (std::size_t i = 0; i < xyz.size(); ++i) {
+    if (std::isfinite(xyz[i])) largest[i % 3] = std::max(largest[i % 3], std::abs(xyz[i]));
+  }
+  int shift[3] = {0, 0, 0};
+  bool any = false;
+  for (int a = 0; a < 3; ++a) {
+    if (largest[a] == 0 || (largest[a] >= 0x1p-100 && largest[a] <= 0x1p100)) continue;
+    std::frexp(largest[a], &shift[a]);
+    shift[a] = -shift[a];
+    any = true;
+  }
+  if (!any) return {};
+  std::vector<double> scaled(xyz.begin(), xyz.end());
+  for (std::size_t i = 0; i < scaled.size(); ++i) scaled[i] = std::ldexp(scaled[i], shift[i % 3]);
+  return scaled;
+}
+
 }  // namespace
 
 MeshStats compute_stats(const IndexedMesh& mesh, const PointCloud* input_points) {
@@ -490,8 +516,9 @@ MeshStats compute_stats(const IndexedMesh& mesh, const PointCloud* input_points)
     measure_stars<std::uint64_t>(welded.triangles, vertex_count, welded.rep, mesh, input_points,
                                  stats, off_mesh);
   }
-  const stats::CrossingCounts crossings =
-      stats::count_crossings(welded.triangles, mesh.xyz.data(), welded.rep);
+  const std::vector<double> scaled = scaled_for_predicates(mesh.xyz);
+  const stats::CrossingCounts crossings = stats::count_crossings(
+      welded.triangles, scaled.empty() ? mesh.xyz.data() : scaled.data(), welded.rep);
   stats.crossing_pairs = crossings.pairs;
   stats.crossing_pairs_no_shared_vertex = crossings.pairs_no_shared_vertex;
   stats.crossing_triangles = crossings.triangles;

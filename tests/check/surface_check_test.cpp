@@ -53,6 +53,19 @@ TEST(SurfaceCheck, CoordinatesBeyondFloatRange) {
   EXPECT_TRUE(says(why_no_surface(cloud_of({0, 0, 0, 1, 0, 0, 0, -1e200, 1})), "along y"));
 }
 
+// Below float's normal range the mesher's float coordinates lose their precision: a torus of
+// 800 points scaled by 1e-44 came out with crossing triangles, at 1e-100 "too sparse", at 1e-250
+// (squared distances underflow in double) "the same point".
+TEST(SurfaceCheck, CloudsTooSmallForFloatAreNamed) {
+  for (const double scale : {1e-44, 1e-100, 1e-250}) {
+    const PointCloud tiny =
+        cloud_of({0, 0, 0, 3 * scale, 0, 0, 0, 2 * scale, 0, 0, 0, scale, scale, scale, scale});
+    EXPECT_TRUE(says(why_no_surface(tiny), "too small for the float coordinates")) << scale;
+  }
+  EXPECT_EQ(why_no_surface(cloud_of({0, 0, 0, 3e-29, 0, 0, 0, 2e-29, 0})), "");
+  EXPECT_TRUE(says(why_no_surface(cloud_of({1e-40, 0, 0, 1e-40, 0, 0})), "all 2 points"));
+}
+
 TEST(SurfaceCheck, ThreePointsOffALineCanMakeASurface) {
   EXPECT_EQ(why_no_surface(cloud_of({0, 0, 0, 1, 0, 0, 0, 1, 0})), "");
 }

@@ -108,6 +108,21 @@ TEST_F(HostileCli, SpecialFilesAsOutput) {
   EXPECT_GT(g2s::read_mesh(path("target.ply")).triangles.size(), 3000u);
 }
 
+// A legal output name of up to 255 bytes is written, whatever the temporaries beside it (the
+// store, the output's temporary, the PLY's spill) add to it: they are named after it cut short.
+// Names from 234 bytes used to fail (exit 4, "File name too long").
+TEST_F(HostileCli, LongestLegalOutputNames) {
+  const fs::path in = cloud("in.ply", "sphere", "2000");
+  for (const char* extension : {".stl", ".ply"}) {
+    const std::string name = std::string(251, 'x') + extension;
+    expect_says(run({"mesh", in.string(), "-o", path(name).string(), "-q"}), kOk, {});
+    EXPECT_GT(g2s::read_mesh(path(name)).triangles.size(), 3000u);
+  }
+  std::size_t files = 0;
+  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir_)) ++files;
+  EXPECT_EQ(files, 3u);  // the input and the two meshes: no temporary left
+}
+
 // Item 3: a kept store is reused only for the cloud and tiling it was made from.
 TEST_F(HostileCli, KeptStoreOfAnotherCloudIsNotReused) {
   const fs::path a = cloud("a.ply", "sphere", "3000");

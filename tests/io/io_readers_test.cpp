@@ -541,6 +541,16 @@ TEST_F(IoXyzReader, SeparatorsCommentsAndExtraColumns) {
                                             1e-3, 2e3, 3.5}));
 }
 
+// Classic Mac OS line ends (CR alone): every line is a point, not the first line alone with
+// the rest taken as extra columns.
+TEST_F(IoXyzReader, CarriageReturnLineEnds) {
+  g2s::ReadReport report;
+  const g2s::PointCloud cloud =
+      g2s::read_points(write("mac.pts", "3\r# comment\r1 2 3\r4 5 6\r7 8 9\r"), &report);
+  EXPECT_EQ(report.declared, 3u);
+  EXPECT_EQ(cloud.xyz, (std::vector<double>{1, 2, 3, 4, 5, 6, 7, 8, 9}));
+}
+
 TEST_F(IoXyzReader, PtsFixtureWithCountLine) {
   g2s::ReadReport report;
   const g2s::PointCloud cloud =

@@ -433,6 +433,32 @@ TEST(StatsCrossings, HandMadeMeshes) {
   EXPECT_EQ(s.crossing_triangles, 4u);
 }
 
+// Coordinates of extreme magnitude (subnormal, or huge) make the exact predicates' products
+// underflow or overflow; each such axis is scaled by a power of two first, which changes no
+// answer. Two triangles touching only at a corner, with x subnormal (a flat scan's x scaled by
+// 1e-321), were counted as crossing; the hand-made crossings keep their counts at any scale.
+TEST(StatsCrossings, ExtremeCoordinatesGiveTheSameAnswers) {
+  const IndexedMesh touching = mesh_of({{4.65e-321, -1.2248693704605103, 0.16210317611694336},
+                                        {-2.515e-321, -1.316306233406067, 0.08252300322055817},
+                                        {2.76e-321, -1.3126708269119263, 0.07718372344970703},
+                                        {-1.05e-321, -1.34033203125, 0.06213152036070824},
+                                        {2.77e-322, -1.343184232711792, 0.0672852098941803}},
+                                       {{1, 3, 4}, {2, 1, 0}});
+  EXPECT_EQ(g2s::compute_stats(touching).crossing_pairs, 0u);
+  EXPECT_EQ(g2s::compute_stats(touching).degenerate_triangles, 0u);
+  const std::vector<Vec3> corners = {{0, 0, 0},  {4, 0, 0}, {4, 4, 0}, {0, 4, 0},
+                                     {2, 2, -1}, {2, 2, 1}, {3, 1, 1}, {2, 1, 0}};
+  for (const Vec3 scale : {Vec3{1e-310, 1, 1}, Vec3{1e-200, 1e-200, 1e-200}, Vec3{1, 1e200, 1},
+                           Vec3{1e250, 1e-250, 1e150}}) {
+    std::vector<Vec3> scaled;
+    for (const Vec3& c : corners) scaled.push_back({c.x * scale.x, c.y * scale.y, c.z * scale.z});
+    const g2s::MeshStats s =
+        g2s::compute_stats(mesh_of(scaled, {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {0, 1, 7}}));
+    EXPECT_EQ(s.crossing_pairs, 3u) << scale.x << " " << scale.y << " " << scale.z;
+    EXPECT_EQ(s.crossing_pairs_no_shared_vertex, 2u);
+  }
+}
+
 TEST(StatsCrossings, CleanClosedMeshHasNone) {
   // An octahedron: every pair shares an edge or a corner, none crosses.
   const IndexedMesh mesh = mesh_of(
