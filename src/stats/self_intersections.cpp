@@ -148,7 +148,8 @@ CrossingCounts count_crossings(std::span<const Triangle> triangles, const double
                      c = corner(triangles[t][2])[k];
         lo[k] = std::min({a, b, c});
         hi[k] = std::max({a, b, c});
-        finite = finite && std::isfinite(lo[k]) && std::isfinite(hi[k]);
+        // Each corner: min and max pass a NaN over when it is not first.
+        finite = finite && std::isfinite(a) && std::isfinite(b) && std::isfinite(c);
       }
       if (!finite) continue;
       usable[t] = 1;
