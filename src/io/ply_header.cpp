@@ -179,6 +179,16 @@ PlyHeader parse_ply_header(const MappedFile& file) {
         }
         property.name = std::string(tokens[2]);
       }
+      // Two x (or y, or z) properties: which one is the coordinate would be a guess. Other
+      // repeated names are left alone (g2s reads no other property).
+      const bool coordinate = property.name == "x" || property.name == "y" || property.name == "z";
+      for (const PlyProperty& before : header.elements.back().properties) {
+        if (coordinate && before.name == property.name) {
+          fail_input(name,
+                     "line {}: a second property '{}' in element '{}' (the first is on line {})", n,
+                     before.name, header.elements.back().name, before.line);
+        }
+      }
       header.elements.back().properties.push_back(std::move(property));
     } else if (key == "end_header") {
       if (tokens.size() != 1) fail_input(name, "line {}: unexpected text after 'end_header'", n);

@@ -59,6 +59,15 @@ TEST_F(HostileReaders, SecondVertexElementIsRefused) {
                {"two.ply", "line 7", "a second element 'vertex'", "line 3"});
 }
 
+TEST_F(HostileReaders, SecondPropertyOfOneNameIsRefused) {
+  const fs::path path = write("twice.ply",
+                              "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
+                              "property float y\nproperty float x\nproperty float z\n"
+                              "end_header\n0 0 1 0\n");
+  expect_error([&] { g2s::read_points(path); }, Exit::bad_input,
+               {"twice.ply", "line 6", "a second property 'x' in element 'vertex'", "line 4"});
+}
+
 TEST_F(HostileReaders, NumbersBeyondDoubleAreNamed) {
   expect_error([&] { g2s::read_points(write("big.xyz", "0 0 0\n1e400 0 0\n")); }, Exit::bad_input,
                {"big.xyz", "line 2", "'1e400'", "beyond the range of double"});
