@@ -52,11 +52,13 @@ Pairs sorted_union(tbb::enumerable_thread_specific<Pairs>& found) {
 }
 }  // namespace
 
-Pairs find_crossings(const HashGrid& grid, std::span<const Triangle> triangles) {
+Pairs find_crossings(const HashGrid& grid, std::span<const Triangle> triangles, std::size_t fixed) {
   const std::size_t n = grid.size();
-  std::vector<std::uint8_t> vertex(n, 0);  // used by some triangle
-  for (const Triangle& t : triangles) {
-    for (const Index v : t) vertex[v] = 1;
+  // Per point: used by some triangle (kCorner), and by one not fixed (kFreeCorner as well).
+  constexpr std::uint8_t kCorner = 1, kFreeCorner = 2;
+  std::vector<std::uint8_t> vertex(n, 0);
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    for (const Index v : triangles[t]) vertex[v] |= t < fixed ? kCorner : kCorner | kFreeCorner;
   }
   const auto ball_of = [&](const Triangle& t, Ball& ball) {
     return padded_circumball(grid.position(t[0]), grid.position(t[1]), grid.position(t[2]), ball);
@@ -72,26 +74,26 @@ Pairs find_crossings(const HashGrid& grid, std::span<const Triangle> triangles) 
   };
   tbb::enumerable_thread_specific<Inside> inside;
   std::vector<std::uint8_t> has_ball(triangles.size(), 0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, triangles.size(), 1024),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      Inside& local = inside.local();
-                      for (std::size_t t = range.begin(); t < range.end(); ++t) {
-                        const Triangle& tri = triangles[t];
-                        Ball ball;
-                        if (!ball_of(tri, ball)) continue;
-                        has_ball[t] = 1;
-                        const auto begin = static_cast<std::uint32_t>(local.vertices.size());
-                        grid.for_each_in_ball(
-                            ball.centre, std::sqrt(ball.radius2), [&](std::uint32_t j, double) {
-                              if (j != tri[0] && j != tri[1] && j != tri[2] && vertex[j]) {
-                                local.vertices.push_back(j);
-                              }
-                            });
-                        const auto end = static_cast<std::uint32_t>(local.vertices.size());
-                        if (end > begin)
-                          local.runs.push_back({static_cast<std::uint32_t>(t), begin, end});
-                      }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, triangles.size(), 1024),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        Inside& local = inside.local();
+        for (std::size_t t = range.begin(); t < range.end(); ++t) {
+          const Triangle& tri = triangles[t];
+          Ball ball;
+          if (!ball_of(tri, ball)) continue;
+          has_ball[t] = 1;
+          const auto begin = static_cast<std::uint32_t>(local.vertices.size());
+          const std::uint8_t wanted = t < fixed ? kFreeCorner : kCorner;
+          grid.for_each_in_ball(ball.centre, std::sqrt(ball.radius2), [&](std::uint32_t j, double) {
+            if (j != tri[0] && j != tri[1] && j != tri[2] && (vertex[j] & wanted)) {
+              local.vertices.push_back(j);
+            }
+          });
+          const auto end = static_cast<std::uint32_t>(local.vertices.size());
+          if (end > begin) local.runs.push_back({static_cast<std::uint32_t>(t), begin, end});
+        }
+      });
   std::vector<std::pair<const Inside*, Run>> uncertified;
   for (const Inside& part : inside) {
     for (const Run& run : part.runs) uncertified.push_back({&part, run});
@@ -148,6 +150,7 @@ Pairs find_crossings(const HashGrid& grid, std::span<const Triangle> triangles) 
                           for (std::uint32_t s = star_begin[v]; s < star_begin[v + 1]; ++s) {
                             const std::uint32_t other = star[s];
                             if (other == id || !has_ball[other]) continue;
+                            if (id < fixed && other < fixed) continue;
                             if (overlap(box, box_of(grid.points(), triangles[other]))) {
                               near.push_back(other);
                             }

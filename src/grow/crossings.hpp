@@ -60,11 +60,14 @@ inline Box box_of(std::span<const Vec3f> points, const Triangle& t) {
 // certified, and the others are tested against the triangles on the vertices in their balls;
 // on a clean scan nearly every triangle is certified. Points no triangle uses play no part, so
 // noise left out of the mesh does not spoil a certificate.
-// Inputs: grid (its points are the corners), triangles. Cost: one ball query per triangle (the
-// vertices found in the balls of uncertified ones are kept, and only their stars are built);
-// the pairs are the same for any thread count.
+// Inputs: grid (its points are the corners), triangles, and `fixed`: the first `fixed`
+// triangles are kept whatever crosses them (a seam's preload), so no pair of two of them is
+// wanted. A fixed triangle's ball then needs to hold a corner of another triangle to leave it
+// uncertified: the argument above still finds every pair with one triangle not fixed. Cost:
+// one ball query per triangle (the vertices found in the balls of uncertified ones are kept,
+// and only their stars are built); the pairs are the same for any thread count.
 std::vector<std::pair<std::uint32_t, std::uint32_t>> find_crossings(
-    const HashGrid& grid, std::span<const Triangle> triangles);
+    const HashGrid& grid, std::span<const Triangle> triangles, std::size_t fixed = 0);
 
 // Triangles filed by the cell of their bounding box's lower corner, in levels of cells each 8
 // times larger than the one before: a triangle is filed in the first level whose cell its box

@@ -640,7 +640,7 @@ class Grower {
   // Corners of removed triangles become suspects of the non-manifold pass.
   std::vector<std::uint8_t> remove_crossings() {
     std::vector<std::uint8_t> dead(triangles_.size(), 0);
-    for (const auto& [first, second] : detail::find_crossings(grid_, triangles_)) {
+    for (const auto& [first, second] : detail::find_crossings(grid_, triangles_, preloaded_)) {
       if (dead[first] || dead[second]) continue;
       if (second >= preloaded_) {
         dead[second] = 1;

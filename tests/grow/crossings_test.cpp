@@ -100,6 +100,23 @@ TEST(Crossings, BothSearchesFindExactlyThePairsOfABruteForceSearch) {
   }
 }
 
+// With the first triangles fixed (a seam's preload), every crossing pair with a triangle not
+// fixed is still found, and no pair of two fixed ones is.
+TEST(Crossings, FixedTrianglesArePairedOnlyWithTheOthers) {
+  for (const int large_every : {0, 7}) {
+    const Soup soup = random_soup(600, large_every, 5u + static_cast<unsigned>(large_every));
+    const Pairs all = brute_force_pairs(soup);
+    for (const std::size_t fixed : {std::size_t{0}, std::size_t{150}, std::size_t{450}}) {
+      Pairs expected;
+      for (const auto& pair : all) {
+        if (pair.second >= fixed) expected.push_back(pair);
+      }
+      ASSERT_GT(expected.size(), 10u);
+      EXPECT_EQ(detail::find_crossings(soup.grid, soup.triangles, fixed), expected) << fixed;
+    }
+  }
+}
+
 TEST(Crossings, CellsWithSeparatingPlanesFindEveryTriangleANewOneCrosses) {
   // Two triangles in three filed; new triangles of their corners (an edge of a filed triangle
   // with the corner nearest its centre) ask whether they cross one.
