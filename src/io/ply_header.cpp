@@ -181,9 +181,9 @@ PlyHeader parse_ply_header(const MappedFile& file) {
       }
       // Two x (or y, or z) properties: which one is the coordinate would be a guess. Other
       // repeated names are left alone (g2s reads no other property).
-      const bool coordinate = property.name == "x" || property.name == "y" || property.name == "z";
-      for (const PlyProperty& before : header.elements.back().properties) {
-        if (coordinate && before.name == property.name) {
+      if (property.name == "x" || property.name == "y" || property.name == "z") {
+        for (const PlyProperty& before : header.elements.back().properties) {
+          if (before.name != property.name) continue;
           fail_input(name,
                      "line {}: a second property '{}' in element '{}' (the first is on line {})", n,
                      before.name, header.elements.back().name, before.line);
