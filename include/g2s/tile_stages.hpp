@@ -69,7 +69,9 @@ struct PipelineSummary {
   std::uint64_t vertices = 0;
   std::uint64_t triangles_stitched = 0;
   // Seam triangles left out because a corner was already finished (a triangle longer than the
-  // stitcher's reach; 0 unless --max-radius is far above the band width).
+  // stitcher's reach; 0 unless --max-radius is far above the band width), or because they cross
+  // a live triangle the seam did not load (one touching only its context: very noisy clouds in
+  // small tiles; 0 on the shared scans).
   std::uint64_t seam_triangles_dropped = 0;
   // Vertices whose fan a late deletion may have split after some of their triangles had left
   // (beyond the release margin; 0 in every test cloud).

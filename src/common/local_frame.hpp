@@ -11,6 +11,8 @@
 #include <span>
 #include <vector>
 
+#include "common/vec3.hpp"
+
 namespace g2s {
 
 class LocalFrame {
@@ -21,6 +23,11 @@ class LocalFrame {
   // Appends point p (3 doubles) in the frame to `out`.
   void append(const double* p, std::vector<float>& out) const {
     for (int a = 0; a < 3; ++a) out.push_back(static_cast<float>(p[a] - centre_[a]));
+  }
+  // Point p (3 doubles) in the frame, as append() gives it.
+  Vec3f point(const double* p) const {
+    return {static_cast<float>(p[0] - centre_[0]), static_cast<float>(p[1] - centre_[1]),
+            static_cast<float>(p[2] - centre_[2])};
   }
   // All points of xyz (3 doubles each) in the frame.
   std::vector<float> convert(std::span<const double> xyz) const {

@@ -5,8 +5,8 @@
 // those seams, with every live triangle that touches those points loaded into the Point-Edge Map:
 // their open edges are the front, and no new triangle can give an edge a third triangle or a vertex
 // a crossing fan the clean-up cannot see. Points farther out are loaded as context, so the Gabriel
-// test sees the whole neighbourhood, but are not used; the live triangles touching only context
-// points are loaded too, so that no new triangle crosses one of them.
+// test sees the whole neighbourhood, but are not used. A new triangle that crosses a live
+// triangle touching only context points (not loaded, so the grower could not see it) is left out.
 //
 // Memory: only the live mesh is kept (stitch/live_mesh.hpp). After each tile the points no later
 // seam can reach are finished and the triangles around them released to the sink
@@ -28,9 +28,11 @@
 
 #include "common/id_map.hpp"
 #include "common/local_frame.hpp"
+#include "common/triangle_intersection.hpp"
 #include "g2s/error.hpp"
 #include "g2s/tile_stages.hpp"
 #include "grid/hash_grid.hpp"
+#include "grow/crossings.hpp"
 #include "grow/grower.hpp"
 #include "stitch/live_mesh.hpp"
 #include "stitch/release.hpp"
@@ -99,16 +101,21 @@ class SeamStitcher {
         if (d <= reach.context) take(border.ids[k], j < tile && d <= band, &border.xyz[3 * k]);
       }
     }
-    // Every live triangle touching the band or its context, presented facing as its group currently
-    // does, so the grower starts from what earlier seams already decided; in the order they were
-    // made.
+    // Every live triangle touching the band, presented facing as its group currently does, so
+    // the grower starts from what earlier seams already decided; in the order they were made.
+    // Those touching only the context are kept aside for the crossing check (crossing_context).
     preload_.clear();
     preload_group_.clear();
     preload_live_.clear();
+    context_corners_.clear();
     for (std::size_t t = 0; t < live.triangles.size(); ++t) {
       const Triangle& tri = live.triangles[t];
-      if (!((live.flags[tri[0]] | live.flags[tri[1]] | live.flags[tri[2]]) &
-            (LiveMesh::kInBand | LiveMesh::kInContext))) {
+      const std::uint8_t touches = live.flags[tri[0]] | live.flags[tri[1]] | live.flags[tri[2]];
+      if (!(touches & LiveMesh::kInBand)) {
+        if (touches & LiveMesh::kInContext) {
+          for (const Index s : tri)
+            context_corners_.push_back(frame.point(&live.xyz[3 * std::size_t{s}]));
+        }
         continue;
       }
       const auto [root, parity] = live.groups.find(live.group[t]);
@@ -151,6 +158,7 @@ class SeamStitcher {
     GrowContext context{preload_, preload_group_, growable, links_, options_.stitch_retries, {}};
     context.cloud_spacing = source_.cloud_spacing();
     GrowResult grown = grow_mesh(grid, mesh_options, context);
+    const std::vector<std::uint8_t> crossing = crossing_context(grid, grown.triangles);
 
     // Orientation: per grower group, the first preloaded triangle anchors it to a live group.
     const std::size_t preloaded = preload_.size();
@@ -192,6 +200,11 @@ class SeamStitcher {
         ++dropped;
         continue;
       }
+      if (crossing[k]) {
+        ++dropped;
+        for (const std::uint32_t c : slots) live.flags[c] |= LiveMesh::kSuspect;  // fans may split
+        continue;
+      }
       const std::size_t s = slot(grown.group[preloaded + k]);
       std::uint8_t flip = grown.flip[preloaded + k];
       std::uint32_t group = 0;
@@ -214,6 +227,28 @@ class SeamStitcher {
   }
 
  private:
+  // Per triangle the seam made: whether it crosses a live triangle that touches only context
+  // points (context_corners_). The grower saw only the preloaded ones, those touching the band;
+  // a new triangle near the band's edge can reach past it (its corners may be a preloaded
+  // triangle's, outside the band) and cross one of these (on very noisy clouds in small tiles).
+  std::vector<std::uint8_t> crossing_context(const HashGrid& grid,
+                                             std::span<const Triangle> made) const {
+    std::vector<std::uint8_t> crossing(made.size(), 0);
+    if (made.empty() || context_corners_.empty()) return crossing;
+    const detail::TriangleCells cells(grid.points(), made);
+    for (std::size_t x = 0; x < context_corners_.size(); x += 3) {
+      const Vec3f* live_corners = &context_corners_[x];
+      const detail::Box box = detail::enclose(
+          detail::enclose({live_corners[0], live_corners[0]}, live_corners[1]), live_corners[2]);
+      cells.for_each_near(box.lo, box.hi, [&](std::uint32_t k, const detail::Box&) {
+        const Vec3f corners[3] = {grid.point(made[k][0]), grid.point(made[k][1]),
+                                  grid.point(made[k][2])};
+        if (!crossing[k] && triangles_cross(corners, live_corners)) crossing[k] = 1;
+      });
+    }
+    return crossing;
+  }
+
   // How the live groups meeting at this seam face each other, decided before growing by a vote
   // of the surface normals on both sides. Left to the grower, the first triangle to join two
   // groups would decide it, and on noisy or layered scans that triangle is often a fold: every
@@ -229,9 +264,6 @@ class SeamStitcher {
     normal_.assign(n, Vec3{0, 0, 0});
     for (std::size_t k = 0; k < preload_.size(); ++k) {
       const Triangle& t = preload_[k];
-      // Only the triangles at the band vote (those touching only context are there for the
-      // crossing test).
-      if (!growable[t[0]] && !growable[t[1]] && !growable[t[2]]) continue;
       const Vec3 a = grid.position(t[0]);
       const Vec3 area = cross(grid.position(t[1]) - a, grid.position(t[2]) - a);
       for (Index v : t) {
@@ -300,6 +332,7 @@ class SeamStitcher {
   std::vector<Triangle> preload_;
   std::vector<std::uint32_t> preload_group_;
   std::vector<std::uint32_t> preload_live_;  // per preloaded triangle: its place in the live mesh
+  std::vector<Vec3f> context_corners_;       // per live triangle touching only context: its corners
   // The orientation vote's scratch: per seam grid point, its label and normal.
   std::vector<std::uint32_t> label_;
   std::vector<Vec3> normal_;
