@@ -27,12 +27,18 @@ namespace {
 
 using g2s::test_support::data_dir;
 
-g2s::PointCloud torus(std::uint64_t points, double noise) {
+g2s::PointCloud synthetic(g2s::SynthShape shape, std::uint64_t points, double noise,
+                          std::uint64_t seed = 1) {
   g2s::SynthOptions o;
-  o.shape = g2s::SynthShape::torus;
+  o.shape = shape;
   o.points = points;
   o.noise = noise;
+  o.seed = seed;
   return g2s::make_synthetic_cloud(o);
+}
+
+g2s::PointCloud torus(std::uint64_t points, double noise) {
+  return synthetic(g2s::SynthShape::torus, points, noise);
 }
 
 g2s::MeshStats stats_of(const g2s::PointCloud& cloud, const g2s::PipelineMesh& mesh) {
@@ -101,12 +107,7 @@ TEST(Pipeline, SeamTrianglesCrossNoLiveTriangleOnVeryNoisyClouds) {
   };
   for (const Case& c : {Case{g2s::SynthShape::torus, 10000, 1, 500},
                         Case{g2s::SynthShape::uneven, 20000, 3, 3000}}) {
-    g2s::SynthOptions o;
-    o.shape = c.shape;
-    o.points = c.points;
-    o.noise = 2;
-    o.seed = c.seed;
-    const g2s::PointCloud cloud = g2s::make_synthetic_cloud(o);
+    const g2s::PointCloud cloud = synthetic(c.shape, c.points, 2, c.seed);
     const g2s::MemoryTiles tiles(cloud, c.tile_points);
     ASSERT_GE(tiles.tiles().size(), 8u);
     const g2s::PipelineMesh mesh = g2s::mesh_tiles(tiles, {});

@@ -448,14 +448,16 @@ TEST(StatsCrossings, ExtremeCoordinatesGiveTheSameAnswers) {
   EXPECT_EQ(g2s::compute_stats(touching).degenerate_triangles, 0u);
   const std::vector<Vec3> corners = {{0, 0, 0},  {4, 0, 0}, {4, 4, 0}, {0, 4, 0},
                                      {2, 2, -1}, {2, 2, 1}, {3, 1, 1}, {2, 1, 0}};
-  for (const Vec3 scale : {Vec3{1e-310, 1, 1}, Vec3{1e-200, 1e-200, 1e-200}, Vec3{1, 1e200, 1},
-                           Vec3{1e250, 1e-250, 1e150}}) {
+  for (const Vec3 scale :
+       {Vec3{1e-310, 1, 1}, Vec3{1e-200, 1e-200, 1e-200}, Vec3{1e-300, 1e-300, 1e-300},
+        Vec3{1, 1e200, 1}, Vec3{1e250, 1e-250, 1e150}}) {
     std::vector<Vec3> scaled;
     for (const Vec3& c : corners) scaled.push_back({c.x * scale.x, c.y * scale.y, c.z * scale.z});
     const g2s::MeshStats s =
         g2s::compute_stats(mesh_of(scaled, {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {0, 1, 7}}));
     EXPECT_EQ(s.crossing_pairs, 3u) << scale.x << " " << scale.y << " " << scale.z;
     EXPECT_EQ(s.crossing_pairs_no_shared_vertex, 2u);
+    EXPECT_EQ(s.degenerate_triangles, 0u) << scale.x << " " << scale.y << " " << scale.z;
   }
 }
 
