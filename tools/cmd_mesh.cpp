@@ -142,7 +142,13 @@ void run_mesh(MeshArgs& args) {
             if (const std::string why = why_tile_too_wide(store); !why.empty()) {
               fmt::print(stderr, "g2s: warning: {}: {}\n", args.input, why);
             }
-            if (summary.report.duplicates_merged > 0) {
+            if (summary.report.duplicates_merged > 0 && store.twin_distance() > 0) {
+              fmt::print(stderr,
+                         "g2s: note: {}: {} duplicate points and near-copies merged (most points "
+                         "have a copy closer than a quarter of the spacing: points within {:.3g} "
+                         "of each other are taken as one)\n",
+                         args.input, summary.report.duplicates_merged, store.twin_distance());
+            } else if (summary.report.duplicates_merged > 0) {
               fmt::print(stderr,
                          "g2s: note: {}: {} duplicate points merged (equal in the mesher's "
                          "float coordinates)\n",

@@ -103,6 +103,7 @@ void run_tile_info(const TileInfoArgs& args) {
         .number("compressed", store.compressed())
         .raw("bounds", box_json(b))
         .number("spacing", store.cloud_spacing())
+        .number("twin_distance", store.twin_distance())
         .raw("input", input.str())
         .raw("tiles", tiles + "]");
     fmt::print("{}\n", json.str());
@@ -116,6 +117,10 @@ void run_tile_info(const TileInfoArgs& args) {
              b.hi[1], b.hi[2]);
   fmt::print("spacing:    {:.6g} (the cloud's median nearest-neighbour distance)\n",
              store.cloud_spacing());
+  if (store.twin_distance() > 0) {
+    fmt::print("twins:      points within {:.6g} of each other are taken as one\n",
+               store.twin_distance());
+  }
   fmt::print("input:      {}, {} declared, {} points, {} non-finite dropped\n", in.format,
              in.declared, in.points, in.non_finite);
   fmt::print("{:>6} {:>10} {:>10} {:>12}  box\n", "tile", "points", "halo", "spacing");

@@ -59,7 +59,7 @@ struct MeshOptions {
 // Counts from one run, for the CLI summary, --json and the tests.
 struct MeshReport {
   std::uint64_t points = 0;             // points given
-  std::uint64_t duplicates_merged = 0;  // exact duplicates left out of meshing
+  std::uint64_t duplicates_merged = 0;  // exact duplicates (and twins' near-copies) left out
   std::uint64_t seeds = 0;              // seed triangles (front components) grown
   std::uint64_t triangles_grown = 0;    // before the non-manifold pass
   std::uint64_t triangles_removed = 0;  // by the non-manifold pass

@@ -6,6 +6,8 @@
 #include <cstring>
 #include <numeric>
 
+#include "common/sample_spacing.hpp"
+
 namespace g2s {
 namespace {
 
@@ -49,7 +51,8 @@ int bits_for(std::int64_t v) {
 
 }  // namespace
 
-HashGrid::HashGrid(std::span<const float> xyz, std::span<const Index> ids) {
+HashGrid::HashGrid(std::span<const float> xyz, std::span<const Index> ids, double twin_distance,
+                   std::span<const std::uint8_t> keep) {
   const std::size_t n = xyz.size() / 3;
   double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
   for (int a = 0; a < 3; ++a) {
@@ -75,6 +78,32 @@ HashGrid::HashGrid(std::span<const float> xyz, std::span<const Index> ids) {
   const double min_cell = extent > 0 ? extent / static_cast<double>(kMaxDim) : 1.0;
 
   build(xyz, ids, std::max(cell, min_cell));
+  // In a cloud of twins, a point with a smaller id within twin_distance is a near-copy of it:
+  // left out, so that its twin's balls stay empty. Decided by id, so every grid holding both
+  // keeps the same one.
+  std::vector<float> kept_xyz;
+  std::vector<Index> kept_ids;
+  std::vector<std::uint32_t> kept_source;
+  const std::uint64_t duplicates = duplicates_;
+  if (twin_distance > 0) {
+    for (std::uint32_t i = 0; i < size(); ++i) {
+      bool copy = false;
+      if (keep.empty() || keep[sources_[i]] == 0) {
+        for_each_in_ball(position(i), twin_distance,
+                         [&](std::uint32_t j, double) { copy = copy || ids_[j] < ids_[i]; });
+      }
+      if (copy) continue;
+      kept_xyz.insert(kept_xyz.end(), {points_[i].x, points_[i].y, points_[i].z});
+      kept_ids.push_back(ids_[i]);
+      kept_source.push_back(sources_[i]);
+    }
+    twins_ = size() - kept_ids.size();
+    if (twins_ > 0) {
+      xyz = kept_xyz;
+      ids = kept_ids;
+      build(xyz, ids, std::max(cell, min_cell));
+    }
+  }
   estimate_spacing();
   // Rebuild with a cell edge of about three spacings: a front search ball (radius about one edge,
   // which on noisy scans is often twice the nearest-neighbour distance) then spans about two
@@ -82,6 +111,10 @@ HashGrid::HashGrid(std::span<const float> xyz, std::span<const Index> ids) {
   // rebuilt, so the cell size, and with it the point order and the mesh, depend only on the
   // distinct points, not on duplicates or on the first guess.
   if (spacing_ > 0) build(xyz, ids, std::max(3.0 * spacing_, min_cell));
+  if (twins_ > 0) {
+    for (std::uint32_t& source : sources_) source = kept_source[source];
+    duplicates_ = duplicates;
+  }
 }
 
 void HashGrid::build(std::span<const float> xyz, std::span<const Index> ids, double cell) {
@@ -176,7 +209,7 @@ void HashGrid::estimate_spacing() {
   // cells is an outlier and is left out rather than searched for across empty space.
   const std::uint64_t threshold = n <= 4096 ? ~0ull : (~0ull / n) * 4096;
   const double max_radius = 64 * cell_;
-  std::vector<double> d;
+  std::vector<NearestThree> samples;
   for (std::uint32_t i = 0; i < n; ++i) {
     const Vec3f& p = points_[i];
     std::uint32_t bits[3];
@@ -186,9 +219,20 @@ void HashGrid::estimate_spacing() {
     h *= 0x9E3779B97F4A7C15ull;
     h ^= h >> 29;
     if (h > threshold) continue;
-    const std::uint32_t j = nearest(i, max_radius, [](std::uint32_t) { return true; });
-    if (j != kNoIndex) d.push_back(std::sqrt(norm2(position(i) - position(j))));
+    // Balls from a quarter cell up, doubling, until one holds three other points (exactly the
+    // nearest three) or reaches max_radius.
+    NearestThree squared;
+    for (double r = std::min(cell_ / 4, max_radius);; r = std::min(r * 2, max_radius)) {
+      squared = {};
+      for_each_in_ball(position(i), r, [&](std::uint32_t j, double d2) {
+        if (j != i) squared.offer(d2);
+      });
+      if (squared.third() <= r * r || r >= max_radius) break;
+    }
+    NearestThree& sample = samples.emplace_back();
+    for (int k = 0; k < 3; ++k) sample.d[k] = std::sqrt(squared.d[k]);
   }
+  std::vector<double> d = spacing_distances(samples).distances;
   if (d.empty()) return;
   // The median: robust to outliers and to the few isolated points every scan has.
   const std::size_t middle = d.size() / 2;

@@ -111,7 +111,7 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
     }
   }
   const std::vector<float> local = LocalFrame(box.lo, box.hi).convert(points.xyz);
-  const HashGrid grid(local, points.ids);
+  const HashGrid grid(local, points.ids, source.twin_distance());
   out.report.points = own;
   out.report.spacing = grid.spacing();
   out.report.seconds_grid =
@@ -144,7 +144,8 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
     }
   }
   auto mine = [&](Index v) { return point_of[v] != kNoIndex; };
-  out.report.duplicates_merged = own - mine_count;  // exact duplicates lie in one tile
+  // Exact duplicates lie in one tile; of twins, the one with the smaller id is kept in every grid.
+  out.report.duplicates_merged = own - mine_count;
   // Dense group numbers in order of first kept triangle: the same on every run.
   std::vector<std::uint32_t> dense(grown.triangles.size(), kNoIndex);
   out.triangles.reserve(grown.triangles.size());

@@ -13,6 +13,8 @@
 #include <numeric>
 #include <vector>
 
+#include "common/sample_spacing.hpp"
+
 namespace g2s::stats {
 
 class BoxTree {
@@ -37,21 +39,50 @@ class BoxTree {
   template <typename Distance>
   double nearest(const double p[3], Distance&& distance, std::uint32_t* best_item = nullptr) const {
     double best = std::numeric_limits<double>::infinity();
-    if (nodes_.empty()) return best;
+    walk_nearest_first(p, best, [&](std::uint32_t item) {
+      const double d = distance(item);
+      if (d >= 0 && d < best) {
+        best = d;
+        if (best_item != nullptr) *best_item = item;
+      }
+    });
+    return best;
+  }
+
+  // The three smallest distance(item) over all items (infinity where fewer), with the same
+  // contract on distance as nearest().
+  template <typename Distance>
+  NearestThree nearest_three(const double p[3], Distance&& distance) const {
+    NearestThree out;
+    walk_nearest_first(p, out.d[2], [&](std::uint32_t item) {
+      const double d = distance(item);
+      if (d >= 0) out.offer(d);
+    });
+    return out;
+  }
+
+  // Calls visit(item) for the items whose boxes lie within `radius` of p (a superset of the
+  // items within radius: the caller measures them).
+  template <typename Visit>
+  void for_each_near(const double p[3], double radius, Visit&& visit) const {
+    const double beyond = std::nextafter(radius, std::numeric_limits<double>::infinity());
+    walk_nearest_first(p, beyond, visit);
+  }
+
+ private:
+  // Visits the leaves' items nearest box first, skipping every box at least `bound` away; visit
+  // may lower bound as it finds items.
+  template <typename Visit>
+  void walk_nearest_first(const double p[3], const double& bound, Visit&& visit) const {
+    if (nodes_.empty()) return;
     std::uint32_t stack[128];
     int top = 0;
     stack[top++] = 0;
     while (top > 0) {
       const Node& node = nodes_[stack[--top]];
-      if (box_distance(node, p) >= best) continue;
+      if (box_distance(node, p) >= bound) continue;
       if (node.count > 0) {
-        for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
-          const double d = distance(order_[i]);
-          if (d >= 0 && d < best) {
-            best = d;
-            if (best_item != nullptr) *best_item = order_[i];
-          }
-        }
+        for (std::uint32_t i = node.first; i < node.first + node.count; ++i) visit(order_[i]);
         continue;
       }
       const std::uint32_t left = static_cast<std::uint32_t>(&node - nodes_.data()) + 1;
@@ -60,30 +91,8 @@ class BoxTree {
       stack[top++] = left_first ? right : left;  // the nearer child is popped first
       stack[top++] = left_first ? left : right;
     }
-    return best;
   }
 
-  // Calls visit(item) for the items whose boxes lie within `radius` of p (a superset of the
-  // items within radius: the caller measures them).
-  template <typename Visit>
-  void for_each_near(const double p[3], double radius, Visit&& visit) const {
-    if (nodes_.empty()) return;
-    std::uint32_t stack[128];
-    int top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-      const Node& node = nodes_[stack[--top]];
-      if (box_distance(node, p) > radius) continue;
-      if (node.count > 0) {
-        for (std::uint32_t i = node.first; i < node.first + node.count; ++i) visit(order_[i]);
-        continue;
-      }
-      stack[top++] = static_cast<std::uint32_t>(&node - nodes_.data()) + 1;
-      stack[top++] = node.first;
-    }
-  }
-
- private:
   static constexpr std::uint32_t kLeafSize = 4;
   struct Node {
     float lo[3], hi[3];

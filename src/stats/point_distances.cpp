@@ -13,6 +13,7 @@
 #include <limits>
 #include <vector>
 
+#include "common/sample_spacing.hpp"
 #include "common/vec3.hpp"
 #include "stats/box_tree.hpp"
 
@@ -63,28 +64,27 @@ bool isolated(const PointCloud& cloud, const PointTree& near, const double* q, d
   return others < 2;
 }
 
-// Median distance from every k-th point to its nearest point at another position.
+// Median spacing distance (common/sample_spacing.hpp) of every k-th point, to the points at other
+// positions.
 double median_spacing(const PointCloud& cloud, const PointTree& near) {
   const std::vector<std::uint32_t>& points = near.points;
   const BoxTree& tree = near.tree;
   if (points.size() < 2) return 0.0;
   const std::size_t step = (points.size() + kSpacingSample - 1) / kSpacingSample;
-  std::vector<double> nearest((points.size() + step - 1) / step);
-  tbb::parallel_for(std::size_t{0}, nearest.size(), [&](std::size_t s) {
+  std::vector<NearestThree> samples((points.size() + step - 1) / step);
+  tbb::parallel_for(std::size_t{0}, samples.size(), [&](std::size_t s) {
     const double* q = &cloud.xyz[3 * std::size_t{points[s * step]}];
     const Vec3 p = at(q);
-    nearest[s] = tree.nearest(q, [&](std::uint32_t i) {
+    samples[s] = tree.nearest_three(q, [&](std::uint32_t i) {
       const double d = norm(at(&cloud.xyz[3 * std::size_t{points[i]}]) - p);
       return d == 0.0 ? -1.0 : d;
     });
   });
   // Points whose every neighbour is at their own position have no spacing.
-  nearest.erase(
-      std::remove(nearest.begin(), nearest.end(), std::numeric_limits<double>::infinity()),
-      nearest.end());
-  if (nearest.empty()) return 0.0;
-  const auto middle = nearest.begin() + static_cast<std::ptrdiff_t>(nearest.size() / 2);
-  std::nth_element(nearest.begin(), middle, nearest.end());
+  std::vector<double> distances = spacing_distances(samples).distances;
+  if (distances.empty()) return 0.0;
+  const auto middle = distances.begin() + static_cast<std::ptrdiff_t>(distances.size() / 2);
+  std::nth_element(distances.begin(), middle, distances.end());
   return *middle;
 }
 

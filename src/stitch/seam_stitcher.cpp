@@ -135,7 +135,16 @@ class SeamStitcher {
       if (s != IdMap::kMissing) live.flags[s] &= ~(LiveMesh::kInBand | LiveMesh::kInContext);
     }
 
-    const HashGrid grid(local_, ids_);
+    // Kept corners stay in the grid in a cloud of twins: a seam's float frame may judge a pair at
+    // the twin distance otherwise than the tile's did.
+    std::vector<std::uint8_t> corner;
+    if (source_.twin_distance() > 0) {
+      corner.assign(ids_.size(), 0);
+      for (const Triangle& t : preload_) {
+        for (const Index v : t) corner[v] = 1;
+      }
+    }
+    const HashGrid grid(local_, ids_, source_.twin_distance(), corner);
     // Place in ids_ -> grid index, for the preloaded corners (the grid keeps the smallest id of
     // exact duplicates, as every tile's grid does, so all kept corners are in it).
     grid_of_.assign(ids_.size(), kNoIndex);

@@ -86,7 +86,7 @@ MemoryTiles::MemoryTiles(const PointCloud& cloud, std::vector<TileBox> boxes) : 
 
 void MemoryTiles::finish(std::vector<std::vector<Index>> members, const TileBox& bounds) {
   members_ = std::move(members);
-  std::vector<double> cloud_sample;
+  std::vector<NearestThree> cloud_sample;
   for (std::size_t t = 0; t < info_.size(); ++t) {
     info_[t].points = members_[t].size();
     const TilePoints points = load(t);
@@ -96,7 +96,9 @@ void MemoryTiles::finish(std::vector<std::vector<Index>> members, const TileBox&
     cloud_sample.insert(cloud_sample.end(), spacing.cloud_sample.begin(),
                         spacing.cloud_sample.end());
   }
-  cloud_spacing_ = tiling::cloud_spacing(std::move(cloud_sample));
+  const tiling::CloudSpacing spacing = tiling::cloud_spacing(cloud_sample);
+  cloud_spacing_ = spacing.spacing;
+  twin_distance_ = spacing.twin_distance;
 }
 
 TilePoints MemoryTiles::load(std::size_t tile) const {

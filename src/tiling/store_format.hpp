@@ -18,8 +18,8 @@ namespace g2s::tiling {
 
 inline constexpr char kMagic[8] = {'G', '2', 'S', 'T', 'I', 'L', 'E', 'S'};
 // 1: no origin; 2: the input's identity and the tiling options (StoreOrigin) in the header;
-// 3: the cloud's spacing in the header.
-inline constexpr std::uint32_t kVersion = 3;
+// 3: the cloud's spacing in the header; 4: its twin distance.
+inline constexpr std::uint32_t kVersion = 4;
 inline constexpr std::uint32_t kFlagCompressed = 1;
 // Points per frame, the unit of compression and of checksums: load_border reads whole frames.
 inline constexpr std::uint32_t kFramePoints = 16384;
@@ -50,6 +50,7 @@ inline constexpr std::size_t origin_content = 176;      // u64, XXH64 of first M
 inline constexpr std::size_t origin_path = 184;         // u64, XXH64 of its absolute path
 inline constexpr std::size_t origin_tile_points = 192;  // u64, the tile_points option
 inline constexpr std::size_t cloud_spacing = 200;       // f64, the cloud's spacing
+inline constexpr std::size_t twin_distance = 208;       // f64, 0 unless a cloud of twins
 inline constexpr std::size_t header_checksum = 248;     // u64, XXH64 of bytes [0, 248)
 }  // namespace header
 inline constexpr std::size_t kHeaderBytes = 256;

@@ -51,6 +51,7 @@ struct TileStore::Impl {
   ReadReport input;
   StoreOrigin origin;
   double cloud_spacing = 0;
+  double twin_distance = 0;
   std::vector<TileInfo> tiles;
   std::vector<std::uint64_t> block_offset;
   std::vector<std::uint64_t> block_bytes;
@@ -133,6 +134,10 @@ void TileStore::Impl::open() {
   cloud_spacing = load_le<double>(h + header::cloud_spacing);
   if (!(cloud_spacing >= 0) || !std::isfinite(cloud_spacing)) {
     fail("header: cloud spacing {} is not a length", cloud_spacing);
+  }
+  twin_distance = load_le<double>(h + header::twin_distance);
+  if (!(twin_distance >= 0) || !(twin_distance <= cloud_spacing)) {
+    fail("header: twin distance {} is not a length below the spacing", twin_distance);
   }
   const auto table_offset = load_le<std::uint64_t>(h + header::table_offset);
   const auto table_bytes = load_le<std::uint64_t>(h + header::table_bytes);
@@ -289,6 +294,10 @@ const TileBox& TileStore::bounds() const {
 }
 double TileStore::cloud_spacing() const {
   return impl_->cloud_spacing;
+}
+
+double TileStore::twin_distance() const {
+  return impl_->twin_distance;
 }
 std::span<const TileInfo> TileStore::tiles() const {
   return impl_->tiles;

@@ -442,7 +442,7 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
   }
 
   BlockScratch scratch;
-  std::vector<double> cloud_sample;
+  std::vector<NearestThree> cloud_sample;
   std::vector<double> xyz(largest_round * 3);
   std::vector<Index> ids(largest_round);
   std::uint64_t written = 0;
@@ -531,7 +531,9 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
   store_le(h + header::origin_content, origin.content);
   store_le(h + header::origin_path, origin.path);
   store_le(h + header::origin_tile_points, origin.tile_points);
-  store_le(h + header::cloud_spacing, cloud_spacing(std::move(cloud_sample)));
+  const CloudSpacing spacing = cloud_spacing(cloud_sample);
+  store_le(h + header::cloud_spacing, spacing.spacing);
+  store_le(h + header::twin_distance, spacing.twin_distance);
   store_le(h + header::header_checksum, xxhash64(h, header::header_checksum));
   file.write_at(0, header.data(), header.size());
   file.write_at(kHeaderBytes, table.data(), table.size());

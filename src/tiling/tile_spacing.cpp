@@ -1,6 +1,6 @@
 // Tile spacing estimates (see tile_spacing.hpp): the points are bucketed by cell once; a sampled
-// point's nearest neighbour is searched in shells of cells around its own, stopping
-// once the best distance found is within the searched cube, so the answer is exact.
+// point's three nearest neighbours are searched in shells of cells around its own, stopping
+// once the third distance found is within the searched cube, so the answer is exact.
 #include "tiling/tile_spacing.hpp"
 
 #include <algorithm>
@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "common/mix64.hpp"
+#include "common/sample_spacing.hpp"
 #include "tiling/store_format.hpp"
 
 namespace g2s::tiling {
@@ -70,12 +71,12 @@ class NeighbourCells {
 
   bool usable() const { return inv_cell_ > 0; }
 
-  // The distance from point i to its nearest distinct neighbour, exact, or infinity when none
-  // lies within kMaxShell cells (an outlier).
-  double nearest_distance(std::size_t i) const {
+  // The distances from point i to its three nearest distinct neighbours, exact, or infinity
+  // for those not within kMaxShell cells (an outlier has none).
+  NearestThree nearest_three(std::size_t i) const {
     const double* p = &xyz_[3 * i];
     const std::int64_t c[3] = {coord(p[0], 0), coord(p[1], 1), coord(p[2], 2)};
-    double best2 = std::numeric_limits<double>::infinity();
+    NearestThree squared;
     const auto visit = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
       if (x < 0 || y < 0 || z < 0 || x >= kMaxCells || y >= kMaxCells || z >= kMaxCells) return;
       const std::size_t b = bucket_of(x, y, z);
@@ -83,9 +84,10 @@ class NeighbourCells {
         const double* q = &xyz_[3 * bucketed_[k]];
         const double d2 = (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
                           (p[2] - q[2]) * (p[2] - q[2]);
-        if (d2 > 0 && d2 < best2) best2 = d2;
+        if (d2 > 0) squared.offer(d2);
       }
     };
+    double reach = 0;
     for (std::int64_t r = 0; r <= kMaxShell; ++r) {
       // The cells of shell r only (the cube's surface): an outlier's search, 16 shells deep,
       // visits 36k cells instead of walking the whole cube of each shell (167k).
@@ -100,10 +102,14 @@ class NeighbourCells {
         }
       }
       // Every point outside the searched cube is at least r cells away.
-      const double reach = static_cast<double>(r) * cell_;
-      if (best2 <= reach * reach) return std::sqrt(best2);
+      reach = static_cast<double>(r) * cell_;
+      if (squared.third() <= reach * reach) break;
     }
-    return std::numeric_limits<double>::infinity();
+    NearestThree out;
+    for (int k = 0; k < 3; ++k) {
+      if (squared.d[k] <= reach * reach) out.d[k] = std::sqrt(squared.d[k]);
+    }
+    return out;
   }
 
  private:
@@ -133,15 +139,12 @@ TileSpacing measure_tile_spacing(std::span<const double> xyz, std::span<const In
   const NeighbourCells cells(xyz);
   if (!cells.usable()) return out;
   const std::size_t step = (n + kSamples - 1) / kSamples;
+  std::vector<NearestThree> samples;
+  for (std::size_t s = 0; s < n; s += step) samples.push_back(cells.nearest_three(s));
+  const std::vector<double> distances = spacing_distances(samples).distances;
   double sum = 0.0;
-  std::size_t found = 0;
-  for (std::size_t s = 0; s < n; s += step) {
-    const double d = cells.nearest_distance(s);
-    if (d == std::numeric_limits<double>::infinity()) continue;
-    sum += d;
-    ++found;
-  }
-  out.mean = found > 0 ? sum / static_cast<double>(found) : 0.0;
+  for (const double d : distances) sum += d;
+  out.mean = distances.empty() ? 0.0 : sum / static_cast<double>(distances.size());
   // The cloud's sample, but the points within kSeamMargin tile spacings of a face of the box
   // inside the cloud: whether a point is left out does not depend on its distance, so the
   // median is not biased. A point kept has no nearer neighbour in another tile than in its own,
@@ -154,17 +157,19 @@ TileSpacing measure_tile_spacing(std::span<const double> xyz, std::span<const In
   for (std::size_t i = 0; i < n; ++i) {
     if (mix64(ids[i]) > threshold) continue;  // by id: the same points in any tiling
     if (faces.distance(&xyz[3 * i]) < margin) continue;
-    const double d = cells.nearest_distance(i);
-    if (d != std::numeric_limits<double>::infinity()) out.cloud_sample.push_back(d);
+    const NearestThree near = cells.nearest_three(i);
+    if (near.d[0] != std::numeric_limits<double>::infinity()) out.cloud_sample.push_back(near);
   }
   return out;
 }
 
-double cloud_spacing(std::vector<double> sample) {
-  if (sample.empty()) return 0.0;
-  const auto middle = sample.begin() + static_cast<std::ptrdiff_t>(sample.size() / 2);
-  std::nth_element(sample.begin(), middle, sample.end());
-  return *middle;
+CloudSpacing cloud_spacing(std::span<const NearestThree> sample) {
+  SpacingDistances measured = spacing_distances(sample);
+  std::vector<double>& distances = measured.distances;
+  if (distances.empty()) return {};
+  const auto middle = distances.begin() + static_cast<std::ptrdiff_t>(distances.size() / 2);
+  std::nth_element(distances.begin(), middle, distances.end());
+  return {*middle, measured.twin_distance};
 }
 
 }  // namespace g2s::tiling

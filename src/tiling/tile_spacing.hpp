@@ -8,19 +8,21 @@
 #include <span>
 #include <vector>
 
+#include "common/sample_spacing.hpp"
 #include "g2s/tile_store.hpp"
 #include "g2s/types.hpp"
 
 namespace g2s::tiling {
 
 struct TileSpacing {
-  // Mean distance from up to 4096 of the points (every k-th) to their nearest distinct
-  // neighbour; 0 for fewer than 2 distinct points.
+  // Mean spacing distance (common/sample_spacing.hpp: the distance to the nearest distinct
+  // neighbour, past twins) of up to 4096 of the points (every k-th); 0 for fewer than 2
+  // distinct points.
   double mean = 0.0;
-  // The nearest-neighbour distances of the tile's points sampled for the cloud (about 65,536
-  // over the whole cloud, chosen by a hash of their ids) but those within 4 tile spacings of a
-  // seam: their distances in the whole cloud wherever these are below 4 tile spacings.
-  std::vector<double> cloud_sample;
+  // The three nearest-neighbour distances of the tile's points sampled for the cloud (about
+  // 65,536 over the whole cloud, chosen by a hash of their ids) but those within 4 tile spacings
+  // of a seam: their distances in the whole cloud wherever these are below 4 tile spacings.
+  std::vector<NearestThree> cloud_sample;
 };
 
 // Inputs: the tile's points (xyz, 3 doubles per point, and their global ids), its box, the
@@ -32,9 +34,14 @@ TileSpacing measure_tile_spacing(std::span<const double> xyz, std::span<const In
                                  const TileBox& box, const TileBox& bounds,
                                  std::uint64_t cloud_points);
 
-// The cloud's spacing: the median of all the tiles' cloud samples (0 if there are none).
-// Nearly the same for any tiling: which points near the seams are left out does not depend on
-// their distances, so the median is not biased (within 1% on a noisy torus in 500-point tiles).
-double cloud_spacing(std::vector<double> sample);
+struct CloudSpacing {
+  double spacing = 0;        // the median spacing distance (0 if there are no samples)
+  double twin_distance = 0;  // in a cloud of twins, the near-copies' reach; 0 otherwise
+};
+
+// The cloud's spacing from all the tiles' cloud samples. Nearly the same for any tiling: which
+// points near the seams are left out does not depend on their distances, so the median is not
+// biased (within 1% on a noisy torus in 500-point tiles).
+CloudSpacing cloud_spacing(std::span<const NearestThree> sample);
 
 }  // namespace g2s::tiling

@@ -263,6 +263,42 @@ TEST_F(BadInput, AllPointsCoplanarMeshAsAnOpenSurface) {
   EXPECT_GE(json_number(json, "coverage"), 0.99) << json;
 }
 
+// A cloud of twins (the patch scanned twice and merged: every point with a copy 1/1000 of the
+// spacing off) meshes through one of each pair, says so, and is as clean as the patch alone.
+TEST_F(BadInput, CloudOfTwinsMeshesThroughOneOfEachPair) {
+  const std::vector<Point> patch = wavy_patch();
+  std::vector<Point> twins = patch;
+  for (std::size_t i = 0; i < patch.size(); ++i) {
+    const double o = (i % 2 == 0 ? 1e-4 : -1e-4);
+    twins.push_back({patch[i][0] + o, patch[i][1] - o, patch[i][2] + o});
+  }
+  const fs::path alone_in = write("patch.xyz", xyz_text(patch));
+  const fs::path alone_out = dir_ / "patch.ply";
+  ASSERT_EQ(mesh(alone_in, alone_out).code, kOk);
+  const fs::path in = write("twins.xyz", xyz_text(twins));
+  const CliRun r = mesh(in, out());
+  ASSERT_EQ(r.code, kOk) << r.err;
+  EXPECT_NE(r.err.find(fmt::format("{} duplicate points and near-copies merged", patch.size())),
+            std::string::npos)
+      << r.err;
+  const g2s::IndexedMesh alone = g2s::read_mesh(alone_out);
+  const g2s::IndexedMesh written = g2s::read_mesh(out());
+  EXPECT_EQ(written.triangles.size(), alone.triangles.size());
+  const std::set<Point> originals(patch.begin(), patch.end());
+  for (std::size_t v = 0; v < written.vertex_count(); ++v) {
+    ASSERT_TRUE(
+        originals.count({written.xyz[3 * v], written.xyz[3 * v + 1], written.xyz[3 * v + 2]}))
+        << "vertex " << v << " is a copy";
+  }
+  const CliRun stats = run({"stats", out().string(), "--points", in.string(), "--json"});
+  ASSERT_EQ(stats.code, kOk) << stats.err;
+  for (const char* defect : {"non_manifold_edges", "non_manifold_vertices", "orientation_conflicts",
+                             "crossing_pairs", "degenerate_triangles", "duplicate_triangles"}) {
+    EXPECT_EQ(json_number(stats.out, defect), 0.0) << defect << "\n" << stats.out;
+  }
+  EXPECT_GE(json_number(stats.out, "coverage"), 0.5) << stats.out;
+}
+
 // A wild value (a corrupt float read as 1e300) cannot be meshed in float and is named.
 TEST_F(BadInput, CoordinateBeyondFloatRangeIsNoSurface) {
   const fs::path in = write("wild.xyz", xyz_text(wavy_patch()) + "0 1e300 0\n2 0 -1e300\n");

@@ -469,6 +469,49 @@ TEST(HashGrid, SpacingIsWithinTenPercentOfTheMedianNearestNeighbourDistance) {
   }
 }
 
+// A cloud of twins: every point of a plane with a copy 1/1000 of the spacing away, the copies
+// listed first but with the larger ids. Given the twin distance, the grid keeps exactly the
+// originals, whatever the order, measures the plane's own spacing and maps them back to their
+// places; points flagged to be kept stay, and without the twin distance every point does.
+TEST(HashGrid, TwinsLeaveOutTheCopyWithTheLargerId) {
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> jitter(-0.1, 0.1);
+  Cloud plane{"jittered lattice", {}};  // no two points nearer than 0.8 steps
+  for (int i = 0; i < 60; ++i) {
+    for (int j = 0; j < 50; ++j) push(plane, i + jitter(rng), j + jitter(rng), 0.0);
+  }
+  const auto n = static_cast<Index>(plane.size());
+  const HashGrid alone(plane.xyz, {});
+  std::normal_distribution<double> g(0.0, 1e-3 * alone.spacing());
+  std::vector<float> xyz;
+  std::vector<Index> ids;
+  for (Index k = 0; k < n; ++k) {
+    const float* p = &plane.xyz[3 * k];
+    xyz.insert(xyz.end(), {static_cast<float>(p[0] + g(rng)), static_cast<float>(p[1] + g(rng)),
+                           static_cast<float>(g(rng))});
+    ids.push_back(n + k);
+    xyz.insert(xyz.end(), p, p + 3);
+    ids.push_back(k);
+  }
+  const HashGrid grid(xyz, ids, 0.25 * alone.spacing());
+  ASSERT_EQ(grid.size(), n);
+  EXPECT_EQ(grid.twins_left_out(), n);
+  EXPECT_EQ(grid.duplicates_merged(), 0u);
+  EXPECT_EQ(grid.spacing(), alone.spacing());
+  for (std::uint32_t i = 0; i < grid.size(); ++i) {
+    ASSERT_LT(grid.id(i), n);
+    const std::uint32_t s = grid.source(i);
+    EXPECT_EQ(ids[s], grid.id(i));
+    EXPECT_EQ(xyz[3 * s], grid.point(i).x);
+    EXPECT_EQ(xyz[3 * s + 1], grid.point(i).y);
+    EXPECT_EQ(xyz[3 * s + 2], grid.point(i).z);
+  }
+  std::vector<std::uint8_t> keep(ids.size(), 0);
+  for (std::size_t s = 0; s < ids.size(); s += 10) keep[s] = 1;  // every fifth copy
+  EXPECT_EQ(HashGrid(xyz, ids, 0.25 * alone.spacing(), keep).size(), n + n / 5);
+  EXPECT_EQ(HashGrid(xyz, ids).size(), 2 * n);
+}
+
 // Under 4,096 points every point is sampled: the spacing is the median of all nearest-neighbour
 // distances, and its lower bound the order statistic m/2 - 1.96 sqrt(m)/2 of them.
 TEST(HashGrid, SpacingLowerBoundIsAnOrderStatisticBelowTheMedian) {

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -115,6 +116,41 @@ TEST(Pipeline, SeamTrianglesCrossNoLiveTriangleOnVeryNoisyClouds) {
     print("noisy cloud in small tiles", s, mesh);
     expect_clean(s);
     EXPECT_LE(mesh.seam_triangles_dropped, 2u);
+  }
+}
+
+// A cloud of twins (every point of a sphere with a near-copy, listed after all the originals):
+// copies 1/1000 or 1/10 of the spacing off are each taken as one with their original, in any
+// tiling, so the mesh is the sphere's own closed mesh through the originals. (Before the spacing
+// was measured past the copies, such clouds gave no surface, or a mesh through 2% of the points.)
+TEST(Pipeline, CloudsOfTwinsMeshAsOneSheet) {
+  const g2s::PointCloud sphere = synthetic(g2s::SynthShape::sphere, 6000, 0);
+  const std::size_t n = sphere.size();
+  for (const double offset : {1e-3, 0.1}) {
+    g2s::PointCloud cloud = sphere;
+    const double step =
+        offset * g2s::synth_spacing({.shape = g2s::SynthShape::sphere, .points = 6000});
+    for (std::size_t i = 0; i < n; ++i) {
+      for (int a = 0; a < 3; ++a) {
+        // A fixed pattern of offsets, about `step` long.
+        const double sign = ((i >> a) & 1) != 0 ? 1.0 : -1.0;
+        cloud.xyz.push_back(sphere.xyz[3 * i + a] + sign * step / std::sqrt(3.0));
+      }
+    }
+    for (const std::uint64_t tile_points : {std::uint64_t{1} << 20, std::uint64_t{2000}}) {
+      const g2s::MemoryTiles tiles(cloud, tile_points);
+      EXPECT_GT(tiles.twin_distance(), 0.0);
+      const g2s::PipelineMesh mesh = g2s::mesh_tiles(tiles, {});
+      const g2s::MeshStats s = stats_of(cloud, mesh);
+      print("sphere of twins", s, mesh);
+      expect_clean(s);
+      EXPECT_EQ(s.boundary_edges, 0u) << offset << " spacing, " << tiles.tiles().size() << " tiles";
+      EXPECT_EQ(s.components, 1u);
+      EXPECT_EQ(s.triangles, 2 * n - 4);
+      for (const g2s::Triangle& t : mesh.triangles) {
+        for (const g2s::Index v : t) ASSERT_LT(v, n) << "a copy is a vertex";
+      }
+    }
   }
 }
 

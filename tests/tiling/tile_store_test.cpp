@@ -506,6 +506,15 @@ class TileStoreDamage : public TileStoreTest {
     b[offset] = static_cast<char>(b[offset] ^ 0x10);
     return b;
   }
+  // The header with the f64 at `offset` set to `value` and its checksum made to hold again.
+  std::string with_header_f64(std::size_t offset, double value) const {
+    namespace header = g2s::tiling::header;
+    std::string b = bytes_;
+    std::memcpy(b.data() + offset, &value, sizeof value);
+    const std::uint64_t checksum = g2s::tiling::xxhash64(b.data(), header::header_checksum);
+    std::memcpy(b.data() + header::header_checksum, &checksum, sizeof checksum);
+    return b;
+  }
   std::uint64_t u64(std::size_t offset) const {
     std::uint64_t v;
     std::memcpy(&v, bytes_.data() + offset, 8);
@@ -522,13 +531,23 @@ TEST_F(TileStoreDamage, CloudSpacingThatIsNoLength) {
   EXPECT_GT(g2s::TileStore(store_).cloud_spacing(), 0.0);
   for (const double spacing :
        {std::numeric_limits<double>::quiet_NaN(), -1.0, std::numeric_limits<double>::infinity()}) {
-    std::string bad = bytes_;
-    std::memcpy(bad.data() + header::cloud_spacing, &spacing, sizeof spacing);
-    const std::uint64_t checksum = g2s::tiling::xxhash64(bad.data(), header::header_checksum);
-    std::memcpy(bad.data() + header::header_checksum, &checksum, sizeof checksum);
-    const fs::path path = damaged(bad);
+    const fs::path path = damaged(with_header_f64(header::cloud_spacing, spacing));
     expect_error([&] { g2s::TileStore s(path); }, Exit::bad_input,
                  {path.string() + ": ", "cloud spacing"});
+  }
+}
+
+// The same for the twin distance, which the grids take as the reach of near-copies: no length, or
+// one beyond the spacing (which would merge whole neighbourhoods).
+TEST_F(TileStoreDamage, TwinDistanceThatIsNoLengthBelowTheSpacing) {
+  namespace header = g2s::tiling::header;
+  const g2s::TileStore store(store_);
+  EXPECT_EQ(store.twin_distance(), 0.0);
+  for (const double twin : {std::numeric_limits<double>::quiet_NaN(), -1.0,
+                            2 * store.cloud_spacing(), std::numeric_limits<double>::infinity()}) {
+    const fs::path path = damaged(with_header_f64(header::twin_distance, twin));
+    expect_error([&] { g2s::TileStore s(path); }, Exit::bad_input,
+                 {path.string() + ": ", "twin distance"});
   }
 }
 
@@ -591,11 +610,12 @@ TEST_F(TileStoreDamage, Truncated) {
 }
 
 TEST_F(TileStoreDamage, VersionMagicAndEmptyFile) {
+  constexpr std::uint32_t version = g2s::tiling::kVersion;
   std::string newer = bytes_;
-  newer[8] = 4;
+  newer[8] = static_cast<char>(version + 1);
   const fs::path path = damaged(newer);
   expect_error([&] { g2s::TileStore s(path); }, Exit::bad_input,
-               {"store version 4, this g2s reads 3"});
+               {fmt::format("store version {}, this g2s reads {}", version + 1, version)});
   const fs::path ply = dir_ / "sphere.ply";
   expect_error([&] { g2s::TileStore s(ply); }, Exit::bad_input,
                {ply.string() + ": ", "not a g2s tile store"});
