@@ -115,8 +115,9 @@ class TileSource {
  public:
   virtual ~TileSource() = default;
   virtual std::span<const TileInfo> tiles() const = 0;
-  // The median distance from a point of the cloud to its nearest neighbour, from a sample of
-  // about 65,536 points chosen by id (0 if there are none): nearly the same for any tiling.
+  // The median distance from a point of the cloud to its nearest neighbour (past its near-copies
+  // in a cloud of twins), from a sample of about 65,536 points chosen by id (0 if there are
+  // none): nearly the same for any tiling.
   virtual double cloud_spacing() const = 0;
   // In a cloud of twins (most points come with a near-copy: the same surface scanned twice and
   // merged), the distance below which two points are taken as one sample; 0 otherwise.

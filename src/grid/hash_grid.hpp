@@ -37,7 +37,8 @@ class HashGrid {
   std::span<const Vec3f> points() const { return points_; }
   std::uint64_t duplicates_merged() const { return duplicates_; }
   std::uint64_t twins_left_out() const { return twins_; }  // near-copies left out
-  double spacing() const { return spacing_; }  // median nearest-neighbour distance (sampled)
+  // The median nearest-neighbour distance of a sample (past twins: common/sample_spacing.hpp).
+  double spacing() const { return spacing_; }
   // A lower 95% confidence bound of that median: the sample's order statistic of rank
   // m/2 - 1.96 sqrt(m)/2 (m distances), above the true median with probability about 2.5%
   // whatever their distribution (the count below the median is binomial). 0 where spacing() is.
