@@ -145,8 +145,8 @@ void run_mesh(MeshArgs& args) {
             if (summary.report.duplicates_merged > 0 && store.twin_distance() > 0) {
               fmt::print(stderr,
                          "g2s: note: {}: {} duplicate points and near-copies merged (most points "
-                         "have a copy closer than a quarter of the spacing: points within {:.3g} "
-                         "of each other are taken as one)\n",
+                         "have a near-copy: points within {:.3g} of each other are taken as "
+                         "one)\n",
                          args.input, summary.report.duplicates_merged, store.twin_distance());
             } else if (summary.report.duplicates_merged > 0) {
               fmt::print(stderr,
