@@ -103,6 +103,7 @@ void run_tile_info(const TileInfoArgs& args) {
         .number("compressed", store.compressed())
         .raw("bounds", box_json(b))
         .number("spacing", store.cloud_spacing())
+        .number("group_distance", store.group_distance())
         .number("twin_distance", store.twin_distance())
         .raw("input", input.str())
         .raw("tiles", tiles + "]");
@@ -117,6 +118,10 @@ void run_tile_info(const TileInfoArgs& args) {
              b.hi[1], b.hi[2]);
   fmt::print("spacing:    {:.6g} (the cloud's median nearest-neighbour distance)\n",
              store.cloud_spacing());
+  if (store.group_distance() > 0) {
+    fmt::print("groups:     points come in groups: the spacing is measured beyond {:.6g}\n",
+               store.group_distance());
+  }
   if (store.twin_distance() > 0) {
     fmt::print("twins:      points within {:.6g} of each other are taken as one\n",
                store.twin_distance());

@@ -119,6 +119,10 @@ class TileSource {
   // in a cloud of twins), from a sample of about 65,536 points chosen by id (0 if there are
   // none): nearly the same for any tiling.
   virtual double cloud_spacing() const = 0;
+  // Where the cloud's points come in groups closer than its sampling (LiDAR returns in pairs,
+  // twins), the distance beyond which a point's nearest neighbour measures the spacing (every
+  // grid measures it so, whatever its own sample says); 0 otherwise.
+  virtual double group_distance() const = 0;
   // In a cloud of twins (most points come with a near-copy: the same surface scanned twice and
   // merged), the distance below which two points are taken as one sample; 0 otherwise.
   virtual double twin_distance() const = 0;
@@ -137,6 +141,7 @@ class MemoryTiles final : public TileSource {
   MemoryTiles(const PointCloud& cloud, std::vector<TileBox> boxes);
   std::span<const TileInfo> tiles() const override { return info_; }
   double cloud_spacing() const override { return cloud_spacing_; }
+  double group_distance() const override { return group_distance_; }
   double twin_distance() const override { return twin_distance_; }
   TilePoints load(std::size_t tile) const override;
   TilePoints load_border(std::size_t tile, double distance) const override;
@@ -145,6 +150,7 @@ class MemoryTiles final : public TileSource {
   void finish(std::vector<std::vector<Index>> members, const TileBox& bounds);
   const PointCloud& cloud_;
   double cloud_spacing_ = 0;
+  double group_distance_ = 0;
   double twin_distance_ = 0;
   std::vector<TileInfo> info_;
   std::vector<std::vector<Index>> members_;  // per tile: ids of its points
@@ -164,6 +170,7 @@ class TileStore final : public TileSource {
   const TileBox& bounds() const;  // bounding box of all points
   std::span<const TileInfo> tiles() const override;
   double cloud_spacing() const override;
+  double group_distance() const override;
   double twin_distance() const override;
   const ReadReport& input_report() const;  // as build_tile_store saw the input
   bool compressed() const;                 // blocks are zstd frames (for g2s tile-info)

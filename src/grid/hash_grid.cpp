@@ -51,8 +51,9 @@ int bits_for(std::int64_t v) {
 
 }  // namespace
 
-HashGrid::HashGrid(std::span<const float> xyz, std::span<const Index> ids, double twin_distance,
-                   std::span<const std::uint8_t> keep) {
+HashGrid::HashGrid(std::span<const float> xyz, std::span<const Index> ids, double group_distance,
+                   double twin_distance, std::span<const std::uint8_t> keep)
+    : group_distance_(group_distance) {
   const std::size_t n = xyz.size() / 3;
   double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
   for (int a = 0; a < 3; ++a) {
@@ -209,7 +210,7 @@ void HashGrid::estimate_spacing() {
   // cells is an outlier and is left out rather than searched for across empty space.
   const std::uint64_t threshold = n <= 4096 ? ~0ull : (~0ull / n) * 4096;
   const double max_radius = 64 * cell_;
-  std::vector<NearestThree> samples;
+  std::vector<double> d;
   for (std::uint32_t i = 0; i < n; ++i) {
     const Vec3f& p = points_[i];
     std::uint32_t bits[3];
@@ -219,8 +220,14 @@ void HashGrid::estimate_spacing() {
     h *= 0x9E3779B97F4A7C15ull;
     h ^= h >> 29;
     if (h > threshold) continue;
-    // Balls from a quarter cell up, doubling, until one holds three other points (exactly the
-    // nearest three) or reaches max_radius.
+    if (group_distance_ == 0) {
+      const std::uint32_t j = nearest(i, max_radius, [](std::uint32_t) { return true; });
+      if (j != kNoIndex) d.push_back(std::sqrt(norm2(position(i) - position(j))));
+      continue;
+    }
+    // Points in groups: the nearest beyond the cloud's group distance, among the three nearest
+    // (balls from a quarter cell up, doubling, until one holds three other points or reaches
+    // max_radius).
     NearestThree squared;
     for (double r = std::min(cell_ / 4, max_radius);; r = std::min(r * 2, max_radius)) {
       squared = {};
@@ -229,10 +236,11 @@ void HashGrid::estimate_spacing() {
       });
       if (squared.third() <= r * r || r >= max_radius) break;
     }
-    NearestThree& sample = samples.emplace_back();
+    NearestThree sample;
     for (int k = 0; k < 3; ++k) sample.d[k] = std::sqrt(squared.d[k]);
+    const double beyond = distance_beyond(sample, group_distance_);
+    if (beyond != std::numeric_limits<double>::infinity()) d.push_back(beyond);
   }
-  std::vector<double> d = spacing_distances(samples).distances;
   if (d.empty()) return;
   // The median: robust to outliers and to the few isolated points every scan has.
   const std::size_t middle = d.size() / 2;

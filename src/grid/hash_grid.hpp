@@ -22,11 +22,13 @@ namespace g2s {
 class HashGrid {
  public:
   // Builds the grid over xyz (3 floats per point) with global ids (empty: 0..n-1). The cell
-  // edge is chosen from the estimated sampling spacing. With twin_distance > 0 (a cloud of twins,
-  // TileSource::twin_distance), a point with a smaller id within that distance is left out as a
-  // near-copy, unless keep (empty, or one flag per point of xyz) flags it.
-  HashGrid(std::span<const float> xyz, std::span<const Index> ids, double twin_distance = 0,
-           std::span<const std::uint8_t> keep = {});
+  // edge is chosen from the estimated sampling spacing. With group_distance > 0 (points in
+  // groups, TileSource::group_distance), the spacing is measured beyond it. With twin_distance >
+  // 0 (a cloud of twins, TileSource::twin_distance), a point with a smaller id within that
+  // distance is left out as a near-copy, unless keep (empty, or one flag per point of xyz) flags
+  // it.
+  HashGrid(std::span<const float> xyz, std::span<const Index> ids, double group_distance = 0,
+           double twin_distance = 0, std::span<const std::uint8_t> keep = {});
 
   std::uint32_t size() const { return static_cast<std::uint32_t>(points_.size()); }
   const Vec3f& point(std::uint32_t i) const { return points_[i]; }
@@ -37,7 +39,7 @@ class HashGrid {
   std::span<const Vec3f> points() const { return points_; }
   std::uint64_t duplicates_merged() const { return duplicates_; }
   std::uint64_t twins_left_out() const { return twins_; }  // near-copies left out
-  // The median nearest-neighbour distance of a sample (past twins: common/sample_spacing.hpp).
+  // The median nearest-neighbour distance of a sample (beyond the group distance, if any).
   double spacing() const { return spacing_; }
   // A lower 95% confidence bound of that median: the sample's order statistic of rank
   // m/2 - 1.96 sqrt(m)/2 (m distances), above the true median with probability about 2.5%
@@ -122,6 +124,7 @@ class HashGrid {
   double spacing_lower_bound_ = 0.0;
   std::uint64_t duplicates_ = 0;
   std::uint64_t twins_ = 0;
+  double group_distance_ = 0;
 };
 
 // std::popcount without a library call on targets built without a popcount instruction (the

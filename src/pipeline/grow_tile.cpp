@@ -111,7 +111,7 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
     }
   }
   const std::vector<float> local = LocalFrame(box.lo, box.hi).convert(points.xyz);
-  const HashGrid grid(local, points.ids, source.twin_distance());
+  const HashGrid grid(local, points.ids, source.group_distance(), source.twin_distance());
   out.report.points = own;
   out.report.spacing = grid.spacing();
   out.report.seconds_grid =

@@ -144,7 +144,7 @@ class SeamStitcher {
         for (const Index v : t) corner[v] = 1;
       }
     }
-    const HashGrid grid(local_, ids_, source_.twin_distance(), corner);
+    const HashGrid grid(local_, ids_, source_.group_distance(), source_.twin_distance(), corner);
     // Place in ids_ -> grid index, for the preloaded corners (the grid keeps the smallest id of
     // exact duplicates, as every tile's grid does, so all kept corners are in it).
     grid_of_.assign(ids_.size(), kNoIndex);

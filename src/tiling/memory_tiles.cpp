@@ -98,6 +98,7 @@ void MemoryTiles::finish(std::vector<std::vector<Index>> members, const TileBox&
   }
   const tiling::CloudSpacing spacing = tiling::cloud_spacing(cloud_sample);
   cloud_spacing_ = spacing.spacing;
+  group_distance_ = spacing.group_distance;
   twin_distance_ = spacing.twin_distance;
 }
 

@@ -18,7 +18,7 @@ namespace g2s::tiling {
 
 inline constexpr char kMagic[8] = {'G', '2', 'S', 'T', 'I', 'L', 'E', 'S'};
 // 1: no origin; 2: the input's identity and the tiling options (StoreOrigin) in the header;
-// 3: the cloud's spacing in the header; 4: its twin distance.
+// 3: the cloud's spacing in the header; 4: its group and twin distances.
 inline constexpr std::uint32_t kVersion = 4;
 inline constexpr std::uint32_t kFlagCompressed = 1;
 // Points per frame, the unit of compression and of checksums: load_border reads whole frames.
@@ -51,6 +51,7 @@ inline constexpr std::size_t origin_path = 184;         // u64, XXH64 of its abs
 inline constexpr std::size_t origin_tile_points = 192;  // u64, the tile_points option
 inline constexpr std::size_t cloud_spacing = 200;       // f64, the cloud's spacing
 inline constexpr std::size_t twin_distance = 208;       // f64, 0 unless a cloud of twins
+inline constexpr std::size_t group_distance = 216;      // f64, 0 unless points come in groups
 inline constexpr std::size_t header_checksum = 248;     // u64, XXH64 of bytes [0, 248)
 }  // namespace header
 inline constexpr std::size_t kHeaderBytes = 256;

@@ -52,6 +52,7 @@ struct TileStore::Impl {
   StoreOrigin origin;
   double cloud_spacing = 0;
   double twin_distance = 0;
+  double group_distance = 0;
   std::vector<TileInfo> tiles;
   std::vector<std::uint64_t> block_offset;
   std::vector<std::uint64_t> block_bytes;
@@ -138,6 +139,11 @@ void TileStore::Impl::open() {
   twin_distance = load_le<double>(h + header::twin_distance);
   if (!(twin_distance >= 0) || !(twin_distance <= cloud_spacing)) {
     fail("header: twin distance {} is not a length below the spacing", twin_distance);
+  }
+  group_distance = load_le<double>(h + header::group_distance);
+  if (!(group_distance >= twin_distance) || !(group_distance <= cloud_spacing)) {
+    fail("header: group distance {} is not a length between the twin distance and the spacing",
+         group_distance);
   }
   const auto table_offset = load_le<std::uint64_t>(h + header::table_offset);
   const auto table_bytes = load_le<std::uint64_t>(h + header::table_bytes);
@@ -298,6 +304,10 @@ double TileStore::cloud_spacing() const {
 
 double TileStore::twin_distance() const {
   return impl_->twin_distance;
+}
+
+double TileStore::group_distance() const {
+  return impl_->group_distance;
 }
 std::span<const TileInfo> TileStore::tiles() const {
   return impl_->tiles;

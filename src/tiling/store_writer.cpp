@@ -534,6 +534,7 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
   const CloudSpacing spacing = cloud_spacing(cloud_sample);
   store_le(h + header::cloud_spacing, spacing.spacing);
   store_le(h + header::twin_distance, spacing.twin_distance);
+  store_le(h + header::group_distance, spacing.group_distance);
   store_le(h + header::header_checksum, xxhash64(h, header::header_checksum));
   file.write_at(0, header.data(), header.size());
   file.write_at(kHeaderBytes, table.data(), table.size());

@@ -169,7 +169,7 @@ CloudSpacing cloud_spacing(std::span<const NearestThree> sample) {
   if (distances.empty()) return {};
   const auto middle = distances.begin() + static_cast<std::ptrdiff_t>(distances.size() / 2);
   std::nth_element(distances.begin(), middle, distances.end());
-  return {*middle, measured.twin_distance};
+  return {*middle, measured.group_distance, measured.twin_distance};
 }
 
 }  // namespace g2s::tiling

@@ -35,8 +35,9 @@ TileSpacing measure_tile_spacing(std::span<const double> xyz, std::span<const In
                                  std::uint64_t cloud_points);
 
 struct CloudSpacing {
-  double spacing = 0;        // the median spacing distance (0 if there are no samples)
-  double twin_distance = 0;  // in a cloud of twins, the near-copies' reach; 0 otherwise
+  double spacing = 0;         // the median spacing distance (0 if there are no samples)
+  double group_distance = 0;  // where points come in groups, the distances' lower cut; else 0
+  double twin_distance = 0;   // in a cloud of twins, the near-copies' reach; 0 otherwise
 };
 
 // The cloud's spacing from all the tiles' cloud samples. Nearly the same for any tiling: which

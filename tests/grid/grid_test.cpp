@@ -493,7 +493,7 @@ TEST(HashGrid, TwinsLeaveOutTheCopyWithTheLargerId) {
     xyz.insert(xyz.end(), p, p + 3);
     ids.push_back(k);
   }
-  const HashGrid grid(xyz, ids, 0.25 * alone.spacing());
+  const HashGrid grid(xyz, ids, 0.5 * alone.spacing(), 0.25 * alone.spacing());
   ASSERT_EQ(grid.size(), n);
   EXPECT_EQ(grid.twins_left_out(), n);
   EXPECT_EQ(grid.duplicates_merged(), 0u);
@@ -508,7 +508,8 @@ TEST(HashGrid, TwinsLeaveOutTheCopyWithTheLargerId) {
   }
   std::vector<std::uint8_t> keep(ids.size(), 0);
   for (std::size_t s = 0; s < ids.size(); s += 10) keep[s] = 1;  // every fifth copy
-  EXPECT_EQ(HashGrid(xyz, ids, 0.25 * alone.spacing(), keep).size(), n + n / 5);
+  EXPECT_EQ(HashGrid(xyz, ids, 0.5 * alone.spacing(), 0.25 * alone.spacing(), keep).size(),
+            n + n / 5);
   EXPECT_EQ(HashGrid(xyz, ids).size(), 2 * n);
 }
 

@@ -537,9 +537,10 @@ TEST_F(TileStoreDamage, CloudSpacingThatIsNoLength) {
   }
 }
 
-// The same for the twin distance, which the grids take as the reach of near-copies: no length, or
-// one beyond the spacing (which would merge whole neighbourhoods).
-TEST_F(TileStoreDamage, TwinDistanceThatIsNoLengthBelowTheSpacing) {
+// The same for the twin and group distances, which the grids take as the reach of near-copies and
+// as the cut their spacing is measured beyond: no length, or one beyond the spacing (which would
+// merge whole neighbourhoods, or measure nothing).
+TEST_F(TileStoreDamage, TwinAndGroupDistancesThatAreNoLengthsBelowTheSpacing) {
   namespace header = g2s::tiling::header;
   const g2s::TileStore store(store_);
   EXPECT_EQ(store.twin_distance(), 0.0);
@@ -548,6 +549,13 @@ TEST_F(TileStoreDamage, TwinDistanceThatIsNoLengthBelowTheSpacing) {
     const fs::path path = damaged(with_header_f64(header::twin_distance, twin));
     expect_error([&] { g2s::TileStore s(path); }, Exit::bad_input,
                  {path.string() + ": ", "twin distance"});
+  }
+  EXPECT_EQ(store.group_distance(), 0.0);
+  for (const double group : {std::numeric_limits<double>::quiet_NaN(), -1.0,
+                             2 * store.cloud_spacing(), std::numeric_limits<double>::infinity()}) {
+    const fs::path path = damaged(with_header_f64(header::group_distance, group));
+    expect_error([&] { g2s::TileStore s(path); }, Exit::bad_input,
+                 {path.string() + ": ", "group distance"});
   }
 }
 
