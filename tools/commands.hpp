@@ -23,5 +23,6 @@ void add_output_options(CLI::App& cmd, OutputArgs& out);
 // Sets how much free memory the allocator may keep for reuse (a 64th of a budget of bytes, at
 // most 32 MiB): g2s mesh calls it with its --memory budget (tools/main.cpp).
 void fit_heap_to_budget(std::uint64_t budget_bytes);
+void one_heap_for_all_threads();
 
 }  // namespace g2s::cli

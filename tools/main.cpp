@@ -62,6 +62,16 @@ void fit_heap_to_budget(std::uint64_t budget_bytes) {
   mallopt(M_TRIM_THRESHOLD, threshold);
 }
 
+// glibc gives each thread that allocates a heap of its own, in 4 KiB pages where the main heap
+// has huge pages (restart_with_huge_pages): with 2 threads, lion took 8,048 page faults against
+// 601 on one, and the work itself ran 5-10% slower. One heap for all: 2-thread wall time -7% on
+// autzen and table-mug, -2% on lion, alpe 33.4 / 32.4 s against 34.3 / 33.6, system time halved;
+// peaks +2-5% (bench/results/2026-12-06-session28.md). The threads allocate per tile and per
+// seam, not in inner loops, so they seldom wait on its lock.
+void one_heap_for_all_threads() {
+  mallopt(M_ARENA_MAX, 1);
+}
+
 }  // namespace g2s::cli
 
 int main(int argc, char** argv) {
@@ -74,6 +84,7 @@ int main(int argc, char** argv) {
       "two distinct, all on one line, too sparse), nothing written; 130 interrupted."};
   g2s::install_interrupt_cleanup();
   g2s::cli::fit_heap_to_budget(std::uint64_t{1} << 40);
+  g2s::cli::one_heap_for_all_threads();
   app.require_subcommand(1);
   app.failure_message(g2s::cli::failure_message);
   app.set_version_flag("--version", "g2s 0.1.0");

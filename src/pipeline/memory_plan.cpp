@@ -25,8 +25,8 @@ constexpr double kWaitingBytesPerPoint = 100;  // a grown tile waiting to be sti
 constexpr double kStitchBytesPerPoint = 150;   // the tile being stitched and released
 constexpr double kFixedBytes = 20e6;  // code, libraries, TBB, buffers: a tiny cloud's whole run
 // What the allocator may keep free for reuse: g2s mesh bounds each heap's two thresholds by a
-// 64th of the budget and 32 MiB, and a run has 3-4 heaps (fit_heap_to_budget, tools/main.cpp):
-// an eighth of the budget, at most 256 MiB.
+// 64th of the budget and 32 MiB, and a run has at most 3-4 heaps (fit_heap_to_budget,
+// tools/main.cpp; g2s itself keeps one): an eighth of the budget, at most 256 MiB.
 constexpr double kMostRetained = 8 * 32.0 * 1048576;
 double heap_retention(double budget) {
   return std::min(budget / 8, kMostRetained);
