@@ -71,8 +71,8 @@ inline double distance_beyond(const NearestThree& s, double group_distance) {
 
 // Inputs: the sampled points' three nearest distances; samples without a finite nearest distance
 // (outliers) are skipped. Output: each other sample's spacing distance, in their order: its
-// nearest distance, or, in a cloud of twins, its nearest beyond kTwinRatio times the median
-// third-nearest distance (samples with none left out).
+// nearest distance, or, where points come in groups, its nearest beyond the group distance
+// (samples with none left out); and the group and twin distances.
 inline SpacingDistances spacing_distances(std::span<const NearestThree> samples) {
   SpacingDistances out;
   std::vector<double>& nearest = out.distances;

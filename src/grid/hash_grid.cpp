@@ -79,9 +79,9 @@ HashGrid::HashGrid(std::span<const float> xyz, std::span<const Index> ids, doubl
   const double min_cell = extent > 0 ? extent / static_cast<double>(kMaxDim) : 1.0;
 
   build(xyz, ids, std::max(cell, min_cell));
-  // In a cloud of twins, a point with a smaller id within twin_distance is a near-copy of it:
-  // left out, so that its twin's balls stay empty. Decided by id, so every grid holding both
-  // keeps the same one.
+  // In a cloud of twins, a point within twin_distance of one with a smaller id is a near-copy of
+  // it: left out, so that the kept one's balls stay empty. Decided by id, so every grid holding
+  // both keeps the same one.
   std::vector<float> kept_xyz;
   std::vector<Index> kept_ids;
   std::vector<std::uint32_t> kept_source;
