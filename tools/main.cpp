@@ -65,8 +65,8 @@ void fit_heap_to_budget(std::uint64_t budget_bytes) {
 // glibc gives each thread that allocates a heap of its own, in 4 KiB pages where the main heap
 // has huge pages (restart_with_huge_pages): with 2 threads, lion took 8,048 page faults against
 // 601 on one, and the work itself ran 5-10% slower. One heap for all: 2-thread wall time -7% on
-// autzen and table-mug, -2% on lion, alpe 33.4 / 32.4 s against 34.3 / 33.6, system time halved;
-// peaks +2-5% (bench/results/2026-12-06-session28.md). The threads allocate per tile and per
+// autzen and table-mug, -2% on lion, alpe within noise, system time halved; peaks +2-5% or less
+// (bench/results/2026-12-06-session28.md). The threads allocate per tile and per
 // seam, not in inner loops, so they seldom wait on its lock.
 void one_heap_for_all_threads() {
   mallopt(M_ARENA_MAX, 1);
