@@ -92,9 +92,10 @@ inline SpacingDistances spacing_distances(std::span<const NearestThree> samples)
   };
   // Where most samples lack a third neighbour within reach, there is no scale to compare with.
   const double scale = median(third);
+  const double middle = median(nearest);
   const double beyond = kTwinRatio * scale;
-  if (scale == std::numeric_limits<double>::infinity() || !(median(nearest) < beyond)) return out;
-  if (median(nearest) < kMergeRatio * scale) out.twin_distance = kMergeReach * scale;
+  if (scale == std::numeric_limits<double>::infinity() || !(middle < beyond)) return out;
+  if (middle < kMergeRatio * scale) out.twin_distance = kMergeReach * scale;
   out.group_distance = beyond;
   nearest.clear();
   for (const NearestThree& s : samples) {

@@ -16,8 +16,8 @@ namespace g2s::tiling {
 
 struct TileSpacing {
   // Mean spacing distance (common/sample_spacing.hpp: the distance to the nearest distinct
-  // neighbour, past twins) of up to 4096 of the points (every k-th); 0 for fewer than 2
-  // distinct points.
+  // neighbour, past groups where the tile's own sample has them) of up to 4096 of the points
+  // (every k-th); 0 for fewer than 2 distinct points.
   double mean = 0.0;
   // The three nearest-neighbour distances of the tile's points sampled for the cloud (about
   // 65,536 over the whole cloud, chosen by a hash of their ids) but those within 4 tile spacings

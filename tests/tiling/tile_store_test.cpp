@@ -27,6 +27,7 @@
 #include <limits>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "g2s/error.hpp"
@@ -544,18 +545,14 @@ TEST_F(TileStoreDamage, TwinAndGroupDistancesThatAreNoLengthsBelowTheSpacing) {
   namespace header = g2s::tiling::header;
   const g2s::TileStore store(store_);
   EXPECT_EQ(store.twin_distance(), 0.0);
-  for (const double twin : {std::numeric_limits<double>::quiet_NaN(), -1.0,
-                            2 * store.cloud_spacing(), std::numeric_limits<double>::infinity()}) {
-    const fs::path path = damaged(with_header_f64(header::twin_distance, twin));
-    expect_error([&] { g2s::TileStore s(path); }, Exit::bad_input,
-                 {path.string() + ": ", "twin distance"});
-  }
   EXPECT_EQ(store.group_distance(), 0.0);
-  for (const double group : {std::numeric_limits<double>::quiet_NaN(), -1.0,
+  for (const auto& [offset, name] : {std::pair{header::twin_distance, "twin distance"},
+                                     std::pair{header::group_distance, "group distance"}}) {
+    for (const double bad : {std::numeric_limits<double>::quiet_NaN(), -1.0,
                              2 * store.cloud_spacing(), std::numeric_limits<double>::infinity()}) {
-    const fs::path path = damaged(with_header_f64(header::group_distance, group));
-    expect_error([&] { g2s::TileStore s(path); }, Exit::bad_input,
-                 {path.string() + ": ", "group distance"});
+      const fs::path path = damaged(with_header_f64(offset, bad));
+      expect_error([&] { g2s::TileStore s(path); }, Exit::bad_input, {path.string() + ": ", name});
+    }
   }
 }
 
