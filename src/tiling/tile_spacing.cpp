@@ -50,9 +50,13 @@ class NeighbourCells {
     cell_ = std::max(cell_, extent / static_cast<double>(kMaxCells - 1));
     inv_cell_ = 1.0 / cell_;
     // Points bucketed by a hash of their cell (a counting sort, O(n)). Cells sharing a bucket
-    // only add candidates: distances are computed exactly, so the answer is unchanged.
+    // only add candidates: distances are computed exactly, so the answer is unchanged. A cell
+    // holds about four points of a surface, so half as many buckets as points is about two per
+    // cell, and the counts fit in cache: the counting sort's scattered increments were most of
+    // the store's spacing pass on tiles of 400k points (the 20M torus's tile command, user time
+    // 2.3 -> 2.0 s, against twice as many buckets as points).
     std::size_t buckets = 64;
-    while (buckets < 2 * n_) buckets *= 2;
+    while (buckets < n_ / 2) buckets *= 2;
     bucket_shift_ = 64 - std::countr_zero(buckets);
     bucket_start_.assign(buckets + 1, 0);
     std::vector<std::uint32_t> point_bucket(n_);
