@@ -1,6 +1,8 @@
 // Tiles cut in memory (MemoryTiles): the TileSource for a cloud already read, and for tests that
 // place seams by hand. The split is the tile store's (src/tiling/tile_split.hpp) on every point,
 // so a cloud small enough for the store to sample whole gets the same tiles either way.
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 
 #include "g2s/error.hpp"
@@ -86,15 +88,18 @@ MemoryTiles::MemoryTiles(const PointCloud& cloud, std::vector<TileBox> boxes) : 
 
 void MemoryTiles::finish(std::vector<std::vector<Index>> members, const TileBox& bounds) {
   members_ = std::move(members);
-  std::vector<NearestThree> cloud_sample;
-  for (std::size_t t = 0; t < info_.size(); ++t) {
+  // The tiles' spacings in parallel (as the tile store measures them), gathered in tile order.
+  std::vector<tiling::TileSpacing> tiles(info_.size());
+  tbb::parallel_for(std::size_t{0}, info_.size(), [&](std::size_t t) {
     info_[t].points = members_[t].size();
     const TilePoints points = load(t);
-    tiling::TileSpacing spacing =
+    tiles[t] =
         tiling::measure_tile_spacing(points.xyz, points.ids, info_[t].box, bounds, cloud_.size());
-    info_[t].spacing = spacing.mean;
-    cloud_sample.insert(cloud_sample.end(), spacing.cloud_sample.begin(),
-                        spacing.cloud_sample.end());
+    info_[t].spacing = tiles[t].mean;
+  });
+  std::vector<NearestThree> cloud_sample;
+  for (const tiling::TileSpacing& s : tiles) {
+    cloud_sample.insert(cloud_sample.end(), s.cloud_sample.begin(), s.cloud_sample.end());
   }
   const tiling::CloudSpacing spacing = tiling::cloud_spacing(cloud_sample);
   cloud_spacing_ = spacing.spacing;
