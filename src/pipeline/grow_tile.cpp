@@ -63,7 +63,12 @@ void clean_deep_fans(TileGrowth& out, const TileFaces& faces, double depth,
 // of the clean-up's release margin: final already) to the front, in order, and counts them, so
 // that the stitcher hands them straight to the output.
 void put_final_first(TileGrowth& out, const TileFaces& faces, double depth) {
-  auto deep = [&](Index v) { return faces.depth(&out.points.xyz[3 * std::size_t{v}]) > depth; };
+  // Per point, once (a point is a corner of about six triangles).
+  std::vector<std::uint8_t> deep_point(out.points.size());
+  for (std::size_t k = 0; k < deep_point.size(); ++k) {
+    deep_point[k] = faces.depth(&out.points.xyz[3 * k]) > depth;
+  }
+  auto deep = [&](Index v) { return deep_point[v] != 0; };
   std::vector<Triangle> rest;
   std::vector<std::uint32_t> rest_group;
   std::size_t final_count = 0;
