@@ -74,13 +74,20 @@ class NeighbourCells {
     for (std::size_t i = 0; i < n_; ++i) {
       std::copy_n(&xyz[3 * i], 3, &bucketed_[3 * fill[point_bucket[i]]++]);
     }
+    scanned_.assign(buckets, 0);
   }
 
   bool usable() const { return inv_cell_ > 0; }
 
   // The distances from point i to its three nearest distinct neighbours, exact, or infinity
   // for those not within kMaxShell cells (an outlier has none).
-  NearestThree nearest_three(std::size_t i) const {
+  NearestThree nearest_three(std::size_t i) {
+    // Two cells of the search may share a bucket: each bucket is read once a search, or its
+    // points would be offered twice and fill two of the three places.
+    if (++search_ == 0) {
+      std::fill(scanned_.begin(), scanned_.end(), 0);
+      search_ = 1;
+    }
     const double* p = &xyz_[3 * i];
     const std::int64_t c[3] = {coord(p[0], 0), coord(p[1], 1), coord(p[2], 2)};
     // The point's place in its cell, per axis, less a slack far above the rounding of coord():
@@ -103,6 +110,8 @@ class NeighbourCells {
     const auto visit = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
       if (x < 0 || y < 0 || z < 0 || x >= kMaxCells || y >= kMaxCells || z >= kMaxCells) return;
       const std::size_t b = bucket_of(x, y, z);
+      if (scanned_[b] == search_) return;
+      scanned_[b] = search_;
       for (std::uint32_t k = bucket_start_[b]; k < bucket_start_[b + 1]; ++k) {
         const double* q = &bucketed_[3 * k];
         const double d2 = (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
@@ -136,9 +145,13 @@ class NeighbourCells {
       reach2 = reach > 0 ? reach * reach : 0.0;
       if (squared.third() <= reach2) break;
     }
+    // Found exactly within reach; neighbours farther than kMaxShell cells do not count.
+    const double limit = static_cast<double>(kMaxShell) * cell_;
     NearestThree out;
     for (int k = 0; k < 3; ++k) {
-      if (squared.d[k] <= reach2) out.d[k] = std::sqrt(squared.d[k]);
+      if (squared.d[k] <= reach2 && squared.d[k] <= limit * limit) {
+        out.d[k] = std::sqrt(squared.d[k]);
+      }
     }
     return out;
   }
@@ -158,7 +171,9 @@ class NeighbourCells {
   double cell_ = 0, inv_cell_ = 0;
   int bucket_shift_ = 0;
   std::vector<std::uint32_t> bucket_start_;
-  std::vector<double> bucketed_;  // xyz in bucket order
+  std::vector<double> bucketed_;        // xyz in bucket order
+  std::vector<std::uint32_t> scanned_;  // per bucket: the last search that read it
+  std::uint32_t search_ = 0;
 };
 
 }  // namespace
@@ -168,7 +183,7 @@ TileSpacing measure_tile_spacing(std::span<const double> xyz, std::span<const In
                                  std::uint64_t cloud_points) {
   TileSpacing out;
   const std::size_t n = xyz.size() / 3;
-  const NeighbourCells cells(xyz);
+  NeighbourCells cells(xyz);
   if (!cells.usable()) return out;
   const std::size_t step = (n + kSamples - 1) / kSamples;
   std::vector<NearestThree> samples;

@@ -89,6 +89,12 @@ TEST(TileSpacing, NeighbourDistancesAreExact) {
     }
     expect_exact(xyz);
   }
+  // Small clouds have few buckets, so cells of one search often share one.
+  for (int seed = 0; seed < 20; ++seed) {
+    std::vector<double> xyz;
+    for (int i = 0; i < 300; ++i) xyz.insert(xyz.end(), {unit(rng), unit(rng), 0.05 * unit(rng)});
+    expect_exact(xyz);
+  }
   {  // a dense patch among sparse points, whose neighbours lie a few cells away
     std::vector<double> xyz;
     for (int i = 0; i < 2000; ++i) xyz.insert(xyz.end(), {0.1 * unit(rng), 0.1 * unit(rng), 0.0});
