@@ -1,6 +1,7 @@
 // Tile spacing estimates (see tile_spacing.hpp): the points are bucketed by cell once; a sampled
-// point's three nearest neighbours are searched in shells of cells around its own, stopping
-// once the third distance found is within the searched cube, so the answer is exact.
+// point's three nearest neighbours are searched in shells of cells around its own, skipping
+// cells beyond the third distance found so far and stopping once that distance is within the
+// searched cube, so the answer is exact.
 #include "tiling/tile_spacing.hpp"
 
 #include <algorithm>
@@ -68,7 +69,7 @@ class NeighbourCells {
     }
     for (std::size_t b = 0; b < buckets; ++b) bucket_start_[b + 1] += bucket_start_[b];
     // The coordinates themselves in bucket order: a cell's points are read from one run of
-    // memory, not gathered from the whole tile (a third less time for the tile store on autzen).
+    // memory, not gathered from the whole tile.
     bucketed_.resize(3 * n_);
     std::vector<std::uint32_t> fill(bucket_start_.begin(), bucket_start_.end() - 1);
     for (std::size_t i = 0; i < n_; ++i) {
