@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <span>
 
 #include "cleanup/cleanup.hpp"
 #include "common/local_frame.hpp"
@@ -29,11 +30,12 @@ namespace {
 // Judges the fans of the suspects deeper than `depth` (see above) and deletes the triangles of
 // all but one fan; the suspects left, and those a deletion may have split, stay in second_fans.
 // out.second_fans[0, halo_corners) are corners of triangles left out at the halo.
-void clean_deep_fans(TileGrowth& out, const TileFaces& faces, double depth,
+// point_depth: each point's depth in the tile (TileFaces::depth).
+void clean_deep_fans(TileGrowth& out, std::span<const double> point_depth, double depth,
                      std::size_t halo_corners) {
   const std::size_t n = out.points.size();
   std::vector<std::uint8_t> deep(n, 0);
-  for (std::size_t k = 0; k < n; ++k) deep[k] = faces.depth(&out.points.xyz[3 * k]) > depth;
+  for (std::size_t k = 0; k < n; ++k) deep[k] = point_depth[k] > depth;
   for (std::size_t k = 0; k < halo_corners; ++k) deep[out.second_fans[k]] = 0;
   std::vector<Index> judged, left;
   for (Index v : out.second_fans) (deep[v] ? judged : left).push_back(v);
@@ -62,13 +64,8 @@ void clean_deep_fans(TileGrowth& out, const TileFaces& faces, double depth,
 // Moves the triangles whose corners all lie deeper than `depth` (out of reach of every seam and
 // of the clean-up's release margin: final already) to the front, in order, and counts them, so
 // that the stitcher hands them straight to the output.
-void put_final_first(TileGrowth& out, const TileFaces& faces, double depth) {
-  // Per point, once (a point is a corner of about six triangles).
-  std::vector<std::uint8_t> deep_point(out.points.size());
-  for (std::size_t k = 0; k < deep_point.size(); ++k) {
-    deep_point[k] = faces.depth(&out.points.xyz[3 * k]) > depth;
-  }
-  auto deep = [&](Index v) { return deep_point[v] != 0; };
+void put_final_first(TileGrowth& out, std::span<const double> point_depth, double depth) {
+  auto deep = [&](Index v) { return point_depth[v] > depth; };
   std::vector<Triangle> rest;
   std::vector<std::uint32_t> rest_group;
   std::size_t final_count = 0;
@@ -180,9 +177,14 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
   grown = GrowResult();
   point_of = std::vector<Index>();
   dense = std::vector<std::uint32_t>();
+  // Each point's depth, once for both (not at every corner of its triangles).
   const TileFaces faces = tile_faces(tiles, tile);
-  clean_deep_fans(out, faces, seam_depth(tiles, tile, options), halo_corners);
-  put_final_first(out, faces, seam_depth(tiles, tile, options, true));
+  std::vector<double> point_depth(out.points.size());
+  for (std::size_t k = 0; k < point_depth.size(); ++k) {
+    point_depth[k] = faces.depth(&out.points.xyz[3 * k]);
+  }
+  clean_deep_fans(out, point_depth, seam_depth(tiles, tile, options), halo_corners);
+  put_final_first(out, point_depth, seam_depth(tiles, tile, options, true));
   out.report.seconds_grow =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - grow_start).count();
   return out;

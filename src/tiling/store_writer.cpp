@@ -255,21 +255,19 @@ struct BlockScratch {
 };
 
 // Sorts (distance, local index) pairs as std::sort would, by distance, then index. They come in
-// index order, so a stable sort by distance alone gives that order: a radix sort on the bits of
-// the distances, which order as unsigned integers where they are not negative (a comparison
-// sort of a tile's points was a fifth of the tile store's time). Negative or NaN distances,
-// which the faces never give, would be left to std::sort.
+// index order, so a stable sort by distance alone gives that order: a radix sort on keys that
+// order as the distances do (a comparison sort of a tile's points was a fifth of the tile store's
+// time). Distances are never NaN.
 void sort_by_distance(std::vector<std::pair<double, std::uint32_t>>& order,
                       std::vector<std::pair<double, std::uint32_t>>& buffer) {
   constexpr int kDigitBits = 16;
   constexpr std::size_t kBuckets = std::size_t{1} << kDigitBits;
+  // The bits of a non-negative double order as unsigned integers; a negative one's, flipped,
+  // order below them. -0.0 is taken as +0.0, which it equals.
   const auto key = [](const std::pair<double, std::uint32_t>& e) {
-    return std::bit_cast<std::uint64_t>(e.first + 0.0);  // -0.0 as +0.0
+    const auto bits = std::bit_cast<std::uint64_t>(e.first + 0.0);
+    return bits >> 63 ? ~bits : bits | std::uint64_t{1} << 63;
   };
-  if (std::any_of(order.begin(), order.end(), [&](const auto& e) { return !(e.first >= 0); })) {
-    std::sort(order.begin(), order.end());
-    return;
-  }
   buffer.resize(order.size());
   std::vector<std::uint32_t> count(kBuckets);
   for (int shift = 0; shift < 64; shift += kDigitBits) {

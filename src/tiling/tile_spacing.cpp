@@ -100,13 +100,15 @@ class NeighbourCells {
       below[a] = offset - static_cast<double>(c[a]) * cell_ - slack;
       above[a] = static_cast<double>(c[a] + 1) * cell_ - offset - slack;
     }
-    // Squared distance from the point to the cells `d` steps away along axis a (0 within).
-    const auto gap2 = [&](int a, std::int64_t d) {
-      const double gap = d < 0   ? below[a] + static_cast<double>(-d - 1) * cell_
-                         : d > 0 ? above[a] + static_cast<double>(d - 1) * cell_
-                                 : 0.0;
-      return gap > 0 ? gap * gap : 0.0;
+    // Distance from the point to the cells `d` steps away along axis a (0 within), and its
+    // square.
+    const auto gap = [&](int a, std::int64_t d) {
+      const double g = d < 0   ? below[a] + static_cast<double>(-d - 1) * cell_
+                       : d > 0 ? above[a] + static_cast<double>(d - 1) * cell_
+                               : 0.0;
+      return std::max(g, 0.0);
     };
+    const auto gap2 = [&](int a, std::int64_t d) { return gap(a, d) * gap(a, d); };
     NearestThree squared;
     const auto visit = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
       if (x < 0 || y < 0 || z < 0 || x >= kMaxCells || y >= kMaxCells || z >= kMaxCells) return;
@@ -132,18 +134,15 @@ class NeighbourCells {
           const double xy2 = x2 + gap2(1, dy);
           if (xy2 > squared.third()) continue;
           const bool side = std::abs(dx) == r || std::abs(dy) == r;
-          for (std::int64_t dz = -r; dz <= r; dz += side ? 1 : 2 * std::max<std::int64_t>(r, 1)) {
+          for (std::int64_t dz = -r; dz <= r; dz += side ? 1 : 2 * r) {
             if (xy2 + gap2(2, dz) <= squared.third()) visit(c[0] + dx, c[1] + dy, c[2] + dz);
           }
         }
       }
-      // Every point outside the searched cube is at least this far.
+      // Every point outside the searched cube lies in a cell r + 1 steps away along some axis.
       double reach = std::numeric_limits<double>::infinity();
-      for (int a = 0; a < 3; ++a) {
-        const double extra = static_cast<double>(r) * cell_;
-        reach = std::min({reach, below[a] + extra, above[a] + extra});
-      }
-      reach2 = reach > 0 ? reach * reach : 0.0;
+      for (int a = 0; a < 3; ++a) reach = std::min({reach, gap(a, -r - 1), gap(a, r + 1)});
+      reach2 = reach * reach;
       if (squared.third() <= reach2) break;
     }
     // Found exactly within reach; neighbours farther than kMaxShell cells do not count.
