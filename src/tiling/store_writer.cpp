@@ -29,6 +29,7 @@
 #include "g2s/surface_check.hpp"
 #include "g2s/tile_store.hpp"
 #include "io/readers.hpp"
+#include "io/write_behind.hpp"
 #include "tiling/store_format.hpp"
 #include "tiling/tile_spacing.hpp"
 #include "tiling/tile_split.hpp"
@@ -158,12 +159,31 @@ class SpillFile {
       fail("cannot write the spill file", err);
     }
   }
-  ~SpillFile() { ::close(fd_); }
+  ~SpillFile() {
+    behind_.reset();  // the write in flight first
+    ::close(fd_);
+  }
   SpillFile(const SpillFile&) = delete;
   SpillFile& operator=(const SpillFile&) = delete;
 
-  void write_at(std::uint64_t offset, const void* data, std::size_t bytes) {
-    whole(::pwrite, static_cast<const char*>(data), bytes, offset, "cannot write the spill file");
+  // From now on, write_behind_at hands writes of up to `capacity` bytes to a thread of its own,
+  // so that the pass fills its buffers while the kernel copies the last one.
+  void write_behind(std::size_t capacity) {
+    behind_ = std::make_unique<WriteBehind>(fd_, capacity);
+    staging_.reserve(capacity);
+  }
+  void write_behind_at(std::uint64_t offset, const void* data, std::size_t bytes) {
+    const char* p = static_cast<const char*>(data);
+    staging_.assign(p, p + bytes);
+    if (const int err = behind_->submit(staging_, offset); err != 0) {
+      fail("cannot write the spill file", err);
+    }
+  }
+  // Waits until every write handed over is done.
+  void wait_written() {
+    if (const int err = behind_ ? behind_->wait() : 0; err != 0) {
+      fail("cannot write the spill file", err);
+    }
   }
   void read_at(std::uint64_t offset, void* data, std::size_t bytes) const {
     whole(::pread, static_cast<char*>(data), bytes, offset, "cannot read back the spill file");
@@ -191,6 +211,8 @@ class SpillFile {
   std::filesystem::path target_;
   TemporaryPath path_;  // removes the name should a signal come before the unlink
   int fd_ = -1;
+  std::unique_ptr<WriteBehind> behind_;
+  std::vector<char> staging_;  // the next write's bytes
 };
 
 // The spill pass: each point goes to its tile's buffer, and a full buffer to the tile's run at
@@ -208,11 +230,12 @@ void spill_points(const std::filesystem::path& input, const TileTree& tree,
   std::vector<Index> ids(per_tile * tiles);
   std::vector<std::uint64_t> flushed(tile_start.begin(), tile_start.end() - 1);  // in tile order
   std::vector<std::size_t> held(tiles, 0);
+  spill.write_behind(3 * sizeof(double) * per_tile);
   const auto flush = [&](std::size_t t) {
-    spill.write_at(3 * sizeof(double) * flushed[t], &xyz[3 * per_tile * t],
-                   3 * sizeof(double) * held[t]);
-    spill.write_at(ids_offset + sizeof(Index) * flushed[t], &ids[per_tile * t],
-                   sizeof(Index) * held[t]);
+    spill.write_behind_at(3 * sizeof(double) * flushed[t], &xyz[3 * per_tile * t],
+                          3 * sizeof(double) * held[t]);
+    spill.write_behind_at(ids_offset + sizeof(Index) * flushed[t], &ids[per_tile * t],
+                          sizeof(Index) * held[t]);
     flushed[t] += held[t];
     held[t] = 0;
   };
@@ -226,6 +249,7 @@ void spill_points(const std::filesystem::path& input, const TileTree& tree,
   });
   check_unchanged(input, report, again);
   for (std::size_t t = 0; t < tiles; ++t) flush(t);
+  spill.wait_written();
 }
 
 struct BlockEntry {
@@ -442,6 +466,7 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
   for (std::uint32_t t = 0; t < tiles; ++t) tile_of_node[leaves[t]] = t;
 
   AtomicFile file(store);
+  file.write_behind();
   std::vector<unsigned char> header(kHeaderBytes, 0);
   std::vector<unsigned char> table(tiles * kEntryBytes, 0);
   file.write(header.data(), header.size());
