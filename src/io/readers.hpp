@@ -26,6 +26,11 @@ inline constexpr std::size_t kScanChunkPoints = std::size_t{1} << 16;
 // one reading path: read_points collects what it streams. Fills `report` as read_points does.
 // Throws Error(bad_input) like read_points; runs already handed to the sink stay handed.
 void scan_points(const std::filesystem::path& path, const PointSink& sink, ReadReport& report);
+// The same, the reading done on a thread of its own a few runs ahead of `sink`, which is called
+// on the calling thread with the same runs in the same order (read_ahead.cpp). In an arena of one
+// thread it is scan_points. Up to three runs are held besides scan_points' own memory.
+void scan_points_ahead(const std::filesystem::path& path, const PointSink& sink,
+                       ReadReport& report);
 
 // read_points and read_mesh on an opened file (point_reader.cpp, mesh_reader.cpp).
 PointCloud read_points_from(const MappedFile& file, ReadReport& report);

@@ -57,7 +57,7 @@ template <class Visit>
 ReadReport for_each_point(const std::filesystem::path& input, Visit&& visit) {
   ReadReport report;
   std::uint64_t id = 0;
-  io::scan_points(
+  io::scan_points_ahead(
       input,
       [&](std::span<const double> xyz) {
         for (std::size_t i = 0; i < xyz.size(); i += 3) visit(&xyz[i], id++);
