@@ -86,6 +86,15 @@ void run_perturb(const SynthArgs& args) {
   } catch (const Error& e) {
     throw Error(e.code(), fmt::format("{}: {}", args.from, e.what()));  // name the cloud
   }
+  // The output holds floats: a coordinate beyond them would be written as an infinity.
+  for (const double v : out.xyz) {
+    if (!std::isfinite(static_cast<float>(v))) {
+      throw Error(Exit::bad_input,
+                  fmt::format("{}: a coordinate of {:.6g} is beyond the 32-bit floats synth "
+                              "writes (±3.4e38); nothing written",
+                              args.from, v));
+    }
+  }
   PlyPointWriter writer(args.output, out.size());
   for (std::size_t i = 0; i < out.size(); ++i) {
     writer.add(static_cast<float>(out.xyz[3 * i]), static_cast<float>(out.xyz[3 * i + 1]),

@@ -44,7 +44,12 @@ class LocalFrame {
   // centre rounded to a multiple of float's step at the range's smallest magnitude. Either way a
   // coordinate read as float minus the origin is again a float, exactly: the mesher decides on
   // the very coordinates the output holds (its crossing test depends on it), while
-  // georeferenced coordinates keep float's precision near the box.
+  // georeferenced coordinates keep float's precision near the box. A range narrower than that
+  // step (one value, a plane square to the axis far from zero) has its centre as the origin:
+  // rounded to the step, it would leave the range up to half a step (3.4e7 at 1e15) from zero,
+  // where float cannot tell its points apart and the crossing test's margins (relative to the
+  // coordinates) swallow the spacing. Floats read from a file lie a step apart, so such a range
+  // of them is one value, and minus the origin it is 0.
   static double origin(double lo, double hi) {
     const double width = hi - lo;
     const double near = std::min(std::abs(lo - width), std::abs(hi + width));
@@ -52,6 +57,7 @@ class LocalFrame {
     int exponent = 0;
     std::frexp(near, &exponent);  // near = f * 2^exponent, f in [0.5, 1)
     const double step = std::ldexp(1.0, exponent - 24);
+    if (width < step) return lo + 0.5 * width;
     return std::round(0.5 * (lo + hi) / step) * step;
   }
   double centre_[3];

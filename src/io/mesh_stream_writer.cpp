@@ -248,6 +248,7 @@ void MeshStreamWriter::vertex(Index, const double xyz[3]) {
   Impl& m = *impl_;
   ++m.vertex_count;
   for (int k = 0; k < 3; ++k) {
+    if (m.format != MeshFormat::ply_binary) require_stl_coordinate(m.target, xyz[k]);
     m.largest = std::max(m.largest, std::abs(xyz[k]));
     m.worst = std::max(m.worst, std::abs(xyz[k] - static_cast<double>(static_cast<float>(xyz[k]))));
     m.as_float = m.as_float && survives_float(xyz[k]);

@@ -12,6 +12,7 @@
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
 #include "io/le_bytes.hpp"
+#include "io/stl_record.hpp"
 
 namespace g2s {
 namespace {
@@ -94,6 +95,11 @@ void write_mesh(const std::filesystem::path& target, std::span<const double> xyz
   if (format == MeshFormat::ply_binary) {
     write_ply_mesh(target, xyz, triangles);
     return;
+  }
+  for (const Triangle& t : triangles) {
+    for (const Index v : t) {
+      for (int k = 0; k < 3; ++k) require_stl_coordinate(target, xyz[3 * std::size_t{v} + k]);
+    }
   }
   StlWriter writer(target, format == MeshFormat::stl_ascii);
   for (const Triangle& t : triangles) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <filesystem>
 
 namespace g2s {
 
@@ -17,5 +18,8 @@ void stl_record(const double a[3], const double b[3], const double c[3], char re
 void stl_normal(const double a[3], const double b[3], const double c[3], float normal[3]);
 void stl_record(const double a[3], const double b[3], const double c[3], const float normal[3],
                 char record[50]);
+// Throws Error(usage) naming `target` when the coordinate turns infinite as a 32-bit float: STL
+// cannot hold it, PLY (double where needed) can.
+void require_stl_coordinate(const std::filesystem::path& target, double value);
 
 }  // namespace g2s

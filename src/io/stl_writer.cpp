@@ -45,6 +45,14 @@ void facet(const double a[3], const double b[3], const double c[3], float corner
 
 }  // namespace
 
+void require_stl_coordinate(const std::filesystem::path& target, double value) {
+  if (std::isfinite(static_cast<float>(value))) return;
+  throw Error(Exit::usage,
+              fmt::format("{}: STL stores 32-bit floats, which cannot hold the coordinate {:.6g} "
+                          "(beyond ±3.4e38); write .ply, which keeps doubles",
+                          target.string(), value));
+}
+
 void stl_normal(const double a[3], const double b[3], const double c[3], float normal[3]) {
   float corners[9];
   facet(a, b, c, corners, normal);

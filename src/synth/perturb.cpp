@@ -8,10 +8,12 @@
 #include <array>
 #include <cmath>
 #include <numeric>
+#include <string>
 #include <vector>
 
 #include "common/local_frame.hpp"
 #include "g2s/error.hpp"
+#include "g2s/surface_check.hpp"
 #include "g2s/synth.hpp"
 #include "grid/hash_grid.hpp"
 #include "synth/counter_rng.hpp"
@@ -41,8 +43,12 @@ Box bounding_box(const PointCloud& cloud) {
 double mean_spacing(const PointCloud& cloud) {
   if (cloud.size() > kNoIndex)
     throw Error(Exit::bad_input, "cloud has more than 4,294,967,295 points");
-  // The grid works in float, in the mesher's frame around the box centre.
+  // The grid works in float, in the mesher's frame around the box centre: a span beyond float
+  // (a wild coordinate such as 1e300) would turn into infinities there.
   const Box box = bounding_box(cloud);
+  if (const std::string why = why_beyond_float(box.lo.data(), box.hi.data()); !why.empty()) {
+    throw Error(Exit::bad_input, "its spacing cannot be measured: " + why);
+  }
   const HashGrid grid(LocalFrame(box.lo.data(), box.hi.data()).convert(cloud.xyz), {});
   if (grid.size() < 2)
     throw Error(Exit::bad_input, "the spacing of a cloud needs at least two distinct points");

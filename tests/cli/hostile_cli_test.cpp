@@ -210,6 +210,59 @@ TEST_F(HostileCli, FarStrayPointNamesFloatPrecision) {
   expect_says(r, kNoSurface, {"float coordinates", "stray point"});
 }
 
+// A plane square to x far from zero (x = 1e15, one value: a double no float equals) meshes as
+// the same plane at x = 0 does, in as little time: the mesher's frame puts it at 0, not up to
+// half a float step (3.4e7) away, where float cannot tell its points apart. At 1e100 too, where
+// the step itself is beyond float.
+TEST_F(HostileCli, PlaneFarFromZeroMeshesAsAtZero) {
+  std::vector<std::uint64_t> triangles;
+  for (const std::string x : {"0", "1e15", "1e100"}) {
+    std::string text;
+    for (int i = 0; i < 60; ++i) {
+      for (int j = 0; j < 60; ++j) {
+        text +=
+            fmt::format("{} {} {}\n", x, 0.01 * i + 0.003 * (j % 3), 0.01 * j + 0.002 * (i % 5));
+      }
+    }
+    const CliRun r = run(
+        {"mesh", write("plane.xyz", text).string(), "-o", path("plane.ply").string(), "--json"});
+    ASSERT_EQ(r.code, kOk) << x << ": " << r.err;
+    const g2s::IndexedMesh mesh = g2s::read_mesh(path("plane.ply"));
+    triangles.push_back(mesh.triangles.size());
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+      EXPECT_EQ(mesh.xyz[3 * v], std::stod(x));  // the output keeps the coordinate exactly
+    }
+  }
+  EXPECT_GT(triangles[0], 6000u);
+  EXPECT_EQ(triangles[1], triangles[0]);
+  EXPECT_EQ(triangles[2], triangles[0]);
+}
+
+// Coordinates beyond float (±3.4e38): STL cannot hold them (exit 2, nothing written; PLY can);
+// synth --from cannot measure a cloud that spans more, nor write such coordinates in its float
+// PLY (exit 3, nothing written). Both used to write infinities, or crash, with exit 0 or 139.
+TEST_F(HostileCli, CoordinatesBeyondFloat) {
+  std::string far;
+  for (int i = 0; i < 30; ++i) {
+    for (int j = 0; j < 30; ++j)
+      far += fmt::format("1e39 {} {}\n", 0.1 * i, 0.1 * j + 0.03 * (i % 2));
+  }
+  const fs::path in = write("far.xyz", far);
+  expect_says(run({"mesh", in.string(), "-o", path("m.stl").string()}), kUsage,
+              {"m.stl", "cannot hold the coordinate 1e+39", "write .ply"});
+  EXPECT_FALSE(fs::exists(path("m.stl")));
+  EXPECT_EQ(run({"mesh", in.string(), "-o", path("m.ply").string(), "-q"}).code, kOk);
+  expect_says(run({"synth", "--from", in.string(), "-o", path("s.ply").string()}), kBadInput,
+              {"far.xyz", "beyond the 32-bit floats"});
+  const fs::path wide = write("wide.xyz", "0 0 0\n1e300 0 0\n0 1 0\n0 0 1\n");
+  expect_says(run({"synth", "--from", wide.string(), "-o", path("s.ply").string(), "--noise", "1"}),
+              kBadInput, {"wide.xyz", "spacing cannot be measured", "span 1e+300"});
+  EXPECT_FALSE(fs::exists(path("s.ply")));
+  for (const fs::directory_entry& e : fs::directory_iterator(dir_)) {
+    EXPECT_NE(e.path().filename().string()[0], '.') << e.path();  // no temporary left
+  }
+}
+
 // Items 7 and 9: values that cannot work are refused in one short line saying what is valid.
 // The peak memory g2s reports is its own, even when the process that started it held far more
 // (Linux carries ru_maxrss over exec): here a Python process touches 400 MB and then becomes g2s.
