@@ -204,8 +204,10 @@ void install_output_signal_handler(const std::string& output, const std::string&
   struct sigaction action {};
   action.sa_handler = on_signal_during_output;
   sigemptyset(&action.sa_mask);
-  ::sigaction(SIGINT, &action, &g_signal.library);
-  ::sigaction(SIGTERM, &action, nullptr);
+  ::sigaction(SIGINT, &action, &g_signal.library);  // the same handler for every one of them
+  for (const int signal : interrupt_signals()) {
+    if (signal != SIGINT) ::sigaction(signal, &action, nullptr);
+  }
 }
 
 }  // namespace

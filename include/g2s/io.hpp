@@ -59,7 +59,11 @@ enum class MeshFormat { stl_binary, stl_ascii, ply_binary };
 // The format for an output path: .ply -> ply_binary, otherwise STL (ascii when asked).
 MeshFormat mesh_format_for(const std::filesystem::path& path, bool ascii_stl);
 
-// Makes SIGINT and SIGTERM remove every open AtomicFile's temporary, print a message and exit
+// The signals that end a run as interrupted: SIGINT (Ctrl-C), SIGTERM (kill, a scheduler's
+// cancel), SIGHUP (the terminal or ssh session closed) and SIGQUIT (Ctrl-\).
+std::span<const int> interrupt_signals();
+
+// Makes the interrupt signals remove every open AtomicFile's temporary, print a message and exit
 // with Exit::interrupted (130). For programs; a library user may keep its own handlers.
 void install_interrupt_cleanup();
 

@@ -1,6 +1,7 @@
-// Ctrl-C and kill leave no half-written output behind: every AtomicFile registers its temporary
-// name here while it is open, and the SIGINT/SIGTERM handler unlinks the registered names (only
-// async-signal-safe calls), says what happened and exits with code 130.
+// Ctrl-C, kill and a closed terminal leave no half-written output behind: every AtomicFile
+// registers its temporary name here while it is open, and the handler of the interrupt signals
+// unlinks the registered names (only async-signal-safe calls), says what happened and exits with
+// code 130.
 #include <signal.h>
 #include <unistd.h>
 
@@ -56,12 +57,16 @@ void unregister_temporary(int slot) {
   g_slots[slot].used.store(false, std::memory_order_release);
 }
 
+std::span<const int> interrupt_signals() {
+  static constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
+  return kSignals;
+}
+
 void install_interrupt_cleanup() {
   struct sigaction action {};
   action.sa_handler = on_signal;
   sigemptyset(&action.sa_mask);
-  ::sigaction(SIGINT, &action, nullptr);
-  ::sigaction(SIGTERM, &action, nullptr);
+  for (const int signal : interrupt_signals()) ::sigaction(signal, &action, nullptr);
 }
 
 }  // namespace g2s

@@ -1,5 +1,6 @@
-// Interrupting the g2s command line leaves nothing behind: SIGINT and SIGTERM while a file is
-// being written remove its temporary, leave no target, and exit with code 130.
+// Interrupting the g2s command line leaves nothing behind: SIGINT, SIGTERM, SIGHUP (a closed
+// terminal) and SIGQUIT while a file is being written remove its temporary, leave no target, and
+// exit with code 130.
 #include <gtest/gtest.h>
 #include <signal.h>
 
@@ -38,6 +39,6 @@ TEST_P(Interrupt, WhileWritingLeavesNoFileAndExits130) {
   EXPECT_TRUE(fs::is_empty(dir)) << "files left in " << dir;
 }
 
-INSTANTIATE_TEST_SUITE_P(Signals, Interrupt, ::testing::Values(SIGINT, SIGTERM));
+INSTANTIATE_TEST_SUITE_P(Signals, Interrupt, ::testing::Values(SIGINT, SIGTERM, SIGHUP, SIGQUIT));
 
 }  // namespace

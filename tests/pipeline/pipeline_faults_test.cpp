@@ -132,12 +132,15 @@ TEST_F(PipelineFaults, InterruptedStagesLeaveNothingAndGrowResumes) {
     }
     return false;
   };
-  EXPECT_EQ(
-      interrupt({"mesh", "cloud.ply", "-o", "m.stl", "--tile-points", "50000", "--threads", "1"},
-                SIGINT, store_made),
-      130);
-  EXPECT_FALSE(fs::exists(dir_ / "m.stl"));
-  EXPECT_TRUE(temporaries().empty());
+  // SIGHUP too: a closed terminal or ssh session (it used to leave the store and the spills).
+  for (int signal : {SIGINT, SIGHUP}) {
+    EXPECT_EQ(
+        interrupt({"mesh", "cloud.ply", "-o", "m.stl", "--tile-points", "50000", "--threads", "1"},
+                  signal, store_made),
+        130);
+    EXPECT_FALSE(fs::exists(dir_ / "m.stl"));
+    EXPECT_TRUE(temporaries().empty());
+  }
 
   ASSERT_EQ(run({"tile", "cloud.ply", "s.store", "--tile-points", "50000", "-q"}).code, 0);
   // grow, one thread: stopped after its first tile; finished tiles stay and are not grown again.
