@@ -24,9 +24,8 @@ struct ReadReport {
   std::uint64_t declared = 0;    // points the header declares (0 for XYZ)
   std::uint64_t points = 0;      // finite points returned
   std::uint64_t non_finite = 0;  // points dropped for a NaN or Inf coordinate
-  // Bytes after the declared vertices of a PLY whose last element is the vertex element (more
-  // data than the header declares, or trailing garbage), ignored; blanks after ASCII rows do not
-  // count.
+  // Bytes after the body a PLY's header declares (more data than it declares, or trailing
+  // garbage), ignored; blanks after ASCII rows do not count.
   std::uint64_t ignored_bytes = 0;
 };
 
@@ -37,9 +36,9 @@ struct ReadReport {
 // (space, tab or comma separated; extra columns ignored; '#' and '//' comment lines; a PTS count
 // line is skipped). The format is chosen by content (a "LASF" signature, a "ply" magic line),
 // not by the file name; another file holding binary bytes is an error. ASCII PLY rows are one
-// per line. A PLY body is read as far as its header declares: bytes after the last element are
-// ignored (counted in report->ignored_bytes when the vertex element is the last element), a body
-// shorter than declared is an error. NaN/Inf points are
+// per line. A PLY body is read as far as its header declares (the elements after the vertices
+// walked without being kept): bytes after the last element are ignored (counted in
+// report->ignored_bytes), a body shorter than declared anywhere is an error. NaN/Inf points are
 // dropped and counted. Duplicates are kept (the mesher merges them). Zero points is not an error
 // here (an empty cloud is returned; the caller decides). Throws Error(bad_input) for a missing,
 // unreadable or malformed file: "<file>: line N: ..." (text, PLY header) or "<file>: byte N: ..."

@@ -247,6 +247,35 @@ class BodyReader {
     return pos + static_cast<std::size_t>(e.count * stride);
   }
 
+  // The file ends right after the elements read, but the header declares more (with rows):
+  // a file cut short there, said as such.
+  [[noreturn]] void nothing_after(std::size_t ei) const {
+    for (std::size_t later = ei + 1; later < header_.elements.size(); ++later) {
+      const PlyElement& missing = header_.elements[later];
+      if (missing.count > 0) {
+        fail_input(name_,
+                   "file ends after the {}, but the header declares {} {} after them (line {}; "
+                   "truncated file?)",
+                   header_.elements[ei].name == "vertex" ? "vertices" : header_.elements[ei].name,
+                   missing.count, missing.name, missing.line);
+      }
+    }
+    fail_input(name_, "file ends early");  // unreachable: only called with rows still declared
+  }
+  // Whether an element after `ei` declares rows.
+  bool rows_after(std::size_t ei) const {
+    for (std::size_t later = ei + 1; later < header_.elements.size(); ++later) {
+      if (header_.elements[later].count > 0) return true;
+    }
+    return false;
+  }
+  // The elements after those read are walked too, without keeping anything, so that a file cut
+  // short anywhere in its declared body is reported (a mesh's faces cut in the middle), and the
+  // bytes after the body are known.
+  bool read_all(std::size_t ei) const {
+    return static_cast<int>(ei) >= vertex_.element && static_cast<int>(ei) >= face_.element;
+  }
+
   void run_binary() {
     std::size_t pos = header_.body_offset;
     for (std::size_t ei = 0; ei < header_.elements.size(); ++ei) {
@@ -260,8 +289,7 @@ class BodyReader {
       } else {
         for (std::uint64_t r = 0; r < e.count; ++r) pos = binary_row(e, pos, r, nullptr);
       }
-      // Elements after the ones we need are never read: trailing data is not our business.
-      if (static_cast<int>(ei) >= vertex_.element && static_cast<int>(ei) >= face_.element) break;
+      if (read_all(ei) && pos == size_ && rows_after(ei)) nothing_after(ei);
     }
     result_.end = pos;
   }
@@ -530,7 +558,7 @@ class BodyReader {
           if (!lines.next_nonblank(line)) ascii_truncated(lines, e, r);
         }
       }
-      if (static_cast<int>(ei) >= vertex_.element && static_cast<int>(ei) >= face_.element) break;
+      if (read_all(ei) && rows_after(ei) && !lines.has_nonblank()) nothing_after(ei);
     }
     result_.end = lines.position();
   }

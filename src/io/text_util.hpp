@@ -115,6 +115,13 @@ class LineCursor {
     return false;
   }
 
+  // Whether anything but blanks and line ends is left.
+  bool has_nonblank() const {
+    for (std::size_t p = pos_; p < data_.size(); ++p) {
+      if (!is_blank(data_[p]) && data_[p] != '\n' && data_[p] != '\r') return true;
+    }
+    return false;
+  }
   std::uint64_t line() const { return line_; }  // number of the line last returned
   std::size_t position() const { return pos_; }
 

@@ -8,11 +8,14 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <span>
 #include <string>
 #include <string_view>
+#include <tuple>
 
 #include "g2s/error.hpp"
 #include "g2s/io.hpp"
+#include "io/readers.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_folder.hpp"
 
@@ -100,6 +103,51 @@ TEST_F(HostileReaders, FacesMissingAfterTheVerticesAreTruncation) {
                               "0 0 0\n1 0 0\n0 1 0\n");
   expect_error([&] { g2s::read_points(path); }, Exit::bad_input,
                {"nofaces.ply", "ends after the vertices", "declares 2 face"});
+}
+
+// A file cut inside its faces (or any element after the vertices) is truncated too, whatever
+// comes before the cut: the elements after the vertices are walked to their declared end, in
+// binary (fixed or list rows) and in ASCII, by the point readers (read and streamed) and the mesh
+// reader. They used to be read as complete (exit 0).
+TEST_F(HostileReaders, FileCutInsideTheFacesIsTruncation) {
+  const std::string vertices =
+      "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
+  const std::string faces = "element face 2\nproperty list uchar int vertex_indices\n";
+  std::string body;
+  for (const float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) {
+    body.append(reinterpret_cast<const char*>(&v), sizeof v);
+  }
+  std::string face;
+  face.push_back('\3');
+  for (const std::int32_t i : {0, 1, 2}) face.append(reinterpret_cast<const char*>(&i), sizeof i);
+  const std::string binary = "ply\nformat binary_little_endian 1.0\n" + vertices + faces +
+                             "end_header\n" + body + face + face.substr(0, 6);
+  const std::string fixed = "ply\nformat binary_little_endian 1.0\n" + vertices +
+                            "element extra 4\nproperty int a\nend_header\n" + body +
+                            std::string(10, '\0');
+  const std::string ascii =
+      "ply\nformat ascii 1.0\n" + vertices + faces + "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n\n";
+  for (const auto& [name, text, where] : {std::tuple{"cut-list.ply", binary, "face 2 of 2"},
+                                          std::tuple{"cut-fixed.ply", fixed, "extra 3 of 4"},
+                                          std::tuple{"cut-ascii.ply", ascii, "face 2 of 2"}}) {
+    SCOPED_TRACE(name);
+    const fs::path path = write(name, text);
+    expect_error([&] { g2s::read_points(path); }, Exit::bad_input, {name, where, "truncated"});
+    expect_error(
+        [&] {
+          g2s::ReadReport report;
+          g2s::io::scan_points(
+              path, [](std::span<const double>) {}, report);
+        },
+        Exit::bad_input, {name, where, "truncated"});
+  }
+  expect_error([&] { g2s::read_mesh(write("cut-mesh.ply", binary)); }, Exit::bad_input,
+               {"cut-mesh.ply", "face 2 of 2", "truncated"});
+  // Whole, the same files read, and bytes after the body are counted as ignored.
+  const fs::path whole = write("whole.ply", binary.substr(0, binary.size() - 6) + face + "tail");
+  g2s::ReadReport report;
+  EXPECT_EQ(g2s::read_points(whole, &report).size(), 3u);
+  EXPECT_EQ(report.ignored_bytes, 4u);
 }
 
 }  // namespace
