@@ -66,7 +66,11 @@ std::pair<std::size_t, std::size_t> tile_range(const std::string& text, std::siz
   } catch (const std::exception&) {
     throw Error(Exit::usage, fmt::format("--tiles {}: expected A-B or A (tile indices)", text));
   }
-  if (first > last || last >= tiles) {
+  if (first > last) {
+    throw Error(Exit::usage,
+                fmt::format("--tiles {}: the range runs backwards (A-B with A <= B)", text));
+  }
+  if (last >= tiles) {
     throw Error(Exit::usage, fmt::format("--tiles {}: the store has tiles 0-{}", text, tiles - 1));
   }
   return {first, last + 1};

@@ -55,11 +55,12 @@ inline bool has_las_signature(const MappedFile& file) {
 // Binary or ASCII STL, welded (stl_reader.cpp); throws Error(bad_input) if it is neither.
 IndexedMesh read_stl(const MappedFile& file);
 
-// True when the file starts with the PLY magic line ("ply", maybe with trailing blanks).
+// True when the file starts with the PLY magic line ("ply", maybe with trailing blanks; alone,
+// a header cut short right after it).
 inline bool has_ply_magic(const MappedFile& file) {
   const std::string_view v = file.view();
-  return v.size() >= 4 && v.substr(0, 3) == "ply" &&
-         (v[3] == '\n' || v[3] == '\r' || v[3] == ' ' || v[3] == '\t');
+  return v.size() >= 3 && v.substr(0, 3) == "ply" &&
+         (v.size() == 3 || v[3] == '\n' || v[3] == '\r' || v[3] == ' ' || v[3] == '\t');
 }
 
 }  // namespace g2s::io

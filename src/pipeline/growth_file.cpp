@@ -136,7 +136,8 @@ TileGrowth read_tile_growth(const std::filesystem::path& file, std::uint32_t til
     throw Error(Exit::usage,
                 fmt::format("{}: grown with other mesh options than these (--radius-steps, "
                             "--flatness-levels, --max-fold, --max-radius, --keep-gaps, "
-                            "--no-orient): give the options g2s grow was given, or grow again",
+                            "--no-orient, --max-hole-edges, --max-hole-rings): give the options "
+                            "g2s grow was given, or grow again",
                             file.string()));
   }
   const auto triangles = tiling::load_le<std::uint64_t>(h + 24);

@@ -178,6 +178,10 @@ TEST_F(HostileCli, GrowthsMadeWithOtherOptions) {
   EXPECT_FALSE(fs::exists(path("m.ply")));
   expect_says(run({"stitch", store, "-o", path("m.ply").string(), "--max-radius", "2", "-q"}), kOk,
               {});
+  // The message names every option that must match, the hole options too.
+  ASSERT_EQ(run({"grow", store, "-q", "--max-hole-edges", "0"}).code, kOk);
+  expect_says(run({"stitch", store, "-o", path("h.ply").string()}), kUsage,
+              {"other mesh options", "--max-hole-edges", "--max-hole-rings"});
 }
 
 // Item 5: points on one line within float precision, also with one stray point, are no

@@ -335,6 +335,15 @@ TEST_F(IoPlyReader, EmptyFile) {
   expect_error([&] { g2s::read_points(path); }, Exit::bad_input, {"empty.ply", "empty"});
 }
 
+// "ply" alone, without even a line end, is a PLY header cut short, not text without points.
+TEST_F(IoPlyReader, MagicWordAlone) {
+  for (const char* text : {"ply", "ply\n"}) {
+    const fs::path path = write("magic.ply", text);
+    expect_error([&] { g2s::read_points(path); }, Exit::bad_input,
+                 {"magic.ply", "file ends inside the PLY header"});
+  }
+}
+
 TEST_F(IoPlyReader, HeaderOnlyWithPoints) {
   const fs::path path = write("header-only.ply", simple_binary_ply(100, 0));
   expect_error(

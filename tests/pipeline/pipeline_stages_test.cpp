@@ -73,8 +73,13 @@ TEST_F(Stages, SeparateProcessesGiveTheBytesOfOneMeshRunForAnyThreadCount) {
   ASSERT_GT(one.size(), 84u);
   EXPECT_TRUE(one == file_bytes(dir_ / "two.stl")) << "1 and 2 threads differ";
   EXPECT_TRUE(one == file_bytes(dir_ / "staged.stl")) << "separate stages differ from g2s mesh";
-  // Growing again finds every tile done: nothing changes.
+  // A range that runs backwards, or past the store's tiles, is refused saying which.
   std::string err;
+  EXPECT_EQ(run({"grow", "s.store", "--tiles", "5-2"}, &err), 2);
+  EXPECT_NE(err.find("runs backwards"), std::string::npos) << err;
+  EXPECT_EQ(run({"grow", "s.store", "--tiles", fmt::format("0-{}", tiles)}, &err), 2);
+  EXPECT_NE(err.find(fmt::format("the store has tiles 0-{}", tiles - 1)), std::string::npos) << err;
+  // Growing again finds every tile done: nothing changes.
   ASSERT_EQ(run({"grow", "s.store"}, &err), 0);
   EXPECT_NE(err.find("(" + std::to_string(tiles) + " already there)"), std::string::npos) << err;
 }
