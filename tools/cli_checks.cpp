@@ -10,6 +10,8 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <string_view>
 #include <system_error>
 
@@ -108,6 +110,21 @@ CLI::Validator count_range(long long lo, long long hi) {
         return "";
       },
       fmt::format("[{} - {}]", lo, hi));
+}
+
+CLI::Validator unsigned_number() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        std::uint64_t value = 0;
+        const char* end = text.data() + text.size();
+        const auto [stop, ec] = std::from_chars(text.data(), end, value);
+        if (ec != std::errc() || stop != end) {
+          return fmt::format("'{}' is not valid: expected a whole number from 0 to {}", text,
+                             std::numeric_limits<std::uint64_t>::max());
+        }
+        return "";
+      },
+      "[0 - 2^64-1]");
 }
 
 CLI::Validator byte_size() {

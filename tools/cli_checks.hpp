@@ -37,6 +37,8 @@ void require_extension(const std::filesystem::path& output, const std::string& e
 // Validators with one-line messages: a finite number in [lo, hi]; a whole number in [lo, hi].
 CLI::Validator finite_range(double lo, double hi);
 CLI::Validator count_range(long long lo, long long hi);
+// Any whole number from 0 to 2^64 - 1, written as such: "-1" is refused, not taken as 2^64 - 1.
+CLI::Validator unsigned_number();
 // A byte size such as 512M or 4G (K, M, G, T, powers of 1024; "MB", "MiB" read as "M"), at least
 // 1 MiB; written back as the number of bytes.
 CLI::Validator byte_size();

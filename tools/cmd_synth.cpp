@@ -174,7 +174,9 @@ void add_synth_command(CLI::App& app) {
                   "Outliers, as a fraction of the points, uniform in the bounding box")
       ->capture_default_str()
       ->check(finite_range(0.0, 100.0));
-  cmd->add_option("--seed", args->seed, "Random seed")->capture_default_str();
+  cmd->add_option("--seed", args->seed, "Random seed")
+      ->check(unsigned_number())
+      ->capture_default_str();
   cmd->callback([args] { run_synth(*args); });
 }
 

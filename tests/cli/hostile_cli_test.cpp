@@ -301,6 +301,7 @@ TEST_F(HostileCli, OptionsThatCannotWork) {
       {{"tile", in, path("s.store").string(), "--tile-points", "1"}, "from 500"},
       {{"mesh", in, "-o", out, "--threads", "-1"}, "a whole number from 0 to"},
       {{"mesh", in, "-o", out, "--memory", "-5G"}, "such as 512M or 4G"},
+      {{"synth", "sphere", "-n", "1000", "--seed", "-1", "-o", out}, "a whole number from 0 to"},
       {{"frobnicate"}, "unknown command 'frobnicate'; the commands are mesh"},
   };
   for (const auto& [args, says] : cases) {
