@@ -91,10 +91,17 @@ bool binary_size_matches(const MappedFile& file, std::uint32_t& count) {
   return file.size() == 84 + 50 * static_cast<std::uint64_t>(count);
 }
 
+// An ASCII STL keyword, in any case: some writers put them in capitals ("FACET NORMAL").
+bool is_word(std::string_view token, std::string_view word) {
+  return token.size() == word.size() &&
+         std::equal(token.begin(), token.end(), word.begin(),
+                    [](char a, char b) { return (a >= 'A' && a <= 'Z' ? a - 'A' + 'a' : a) == b; });
+}
+
 bool starts_with_solid(std::string_view v) {
   std::size_t i = 0;
   while (i < v.size() && (is_blank(v[i]) || v[i] == '\n')) ++i;
-  return v.substr(i, 5) == "solid";
+  return is_word(v.substr(i, 5), "solid");
 }
 
 // Bytes no ASCII STL holds: a binary STL whose 80-byte header starts with "solid" (many
@@ -169,7 +176,7 @@ IndexedMesh read_ascii_stl(const MappedFile& file) {
       fail_input(name, "line {}: file ends inside {} (expected '{}'; truncated file?)",
                  tokens.line(), context, word);
     }
-    if (tok != word) {
+    if (!is_word(tok, word)) {
       fail_input(name, "line {}: expected '{}' in {}, found {}", tokens.line(), word, context,
                  quote_token(tok));
     }
@@ -187,7 +194,7 @@ IndexedMesh read_ascii_stl(const MappedFile& file) {
 
   while (tokens.next(tok)) {
     if (!in_solid) {
-      if (tok != "solid") {
+      if (!is_word(tok, "solid")) {
         fail_input(name, "line {}: expected 'solid' (an ASCII STL), found {}", tokens.line(),
                    quote_token(tok));
       }
@@ -195,12 +202,12 @@ IndexedMesh read_ascii_stl(const MappedFile& file) {
       in_solid = true;
       continue;
     }
-    if (tok == "endsolid") {
+    if (is_word(tok, "endsolid")) {
       tokens.skip_line();
       in_solid = false;
       continue;
     }
-    if (tok != "facet") {
+    if (!is_word(tok, "facet")) {
       fail_input(name, "line {}: expected 'facet' or 'endsolid', found {}", tokens.line(),
                  quote_token(tok));
     }
@@ -216,8 +223,8 @@ IndexedMesh read_ascii_stl(const MappedFile& file) {
         fail_input(name, "line {}: file ends inside facet {} (truncated file?)", tokens.line(),
                    facets + 1);
       }
-      if (tok == "endloop") break;
-      if (tok != "vertex") {
+      if (is_word(tok, "endloop")) break;
+      if (!is_word(tok, "vertex")) {
         fail_input(name, "line {}: facet {}: expected 'vertex' or 'endloop', found {}",
                    tokens.line(), facets + 1, quote_token(tok));
       }

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <bit>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -655,6 +656,23 @@ TEST_F(IoMeshReader, AsciiStlFixtureIsWelded) {
   EXPECT_EQ(mesh.xyz, (std::vector<double>{0, 0, 0, 0, 1, 0, 1, 0, 0, 0, 0, 1}));
   EXPECT_EQ(mesh.triangles[0], (g2s::Triangle{0, 1, 2}));
   EXPECT_EQ(mesh.triangles[3], (g2s::Triangle{2, 1, 3}));
+}
+
+// Keywords in capitals (some CAD writers) or mixed case read as in lower case.
+TEST_F(IoMeshReader, AsciiStlKeywordsInAnyCase) {
+  const std::string lower =
+      "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+      "endloop\nendfacet\nendsolid t\n";
+  std::string upper = lower, mixed = lower;
+  for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  mixed.replace(mixed.find("facet"), 5, "Facet");
+  const g2s::IndexedMesh expected = g2s::read_mesh(write("lower.txt", lower));
+  ASSERT_EQ(expected.triangles.size(), 1u);
+  for (const auto& [name, text] : {std::pair{"upper.txt", upper}, std::pair{"mixed.txt", mixed}}) {
+    const g2s::IndexedMesh mesh = g2s::read_mesh(write(name, text));
+    EXPECT_EQ(mesh.xyz, expected.xyz) << name;
+    EXPECT_EQ(mesh.triangles, expected.triangles) << name;
+  }
 }
 
 TEST_F(IoMeshReader, BinaryStlWithSolidHeaderIsBinary) {
