@@ -130,7 +130,7 @@ CLI::Validator unsigned_number() {
 CLI::Validator byte_size() {
   return CLI::Validator(
       [](std::string& text) -> std::string {
-        const std::string error = fmt::format(
+        std::string error = fmt::format(
             "'{}' is not valid: expected a size of at least 1M such as 512M or 4G (suffixes K, "
             "M, G, T)",
             text);

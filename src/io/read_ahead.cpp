@@ -7,6 +7,7 @@
 // the runs before it, as it would there.
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <condition_variable>
 #include <exception>
 #include <mutex>
@@ -40,9 +41,11 @@ void scan_points_ahead(const std::filesystem::path& path, const PointSink& sink,
   bool done = false, stop = false;
   std::exception_ptr error;
   ReadReport read;
-  // The reader joins the caller's arena, so that a reader that parses in parallel (text) keeps
-  // to the caller's thread count.
-  tbb::task_arena arena(tbb::task_arena::attach{});
+  // The reader runs in an arena of its own, one thread fewer than the caller's, so that a reader
+  // that parses in parallel (text) keeps to the caller's thread count with the caller's thread
+  // taking the runs. Not the caller's arena: there it could wait for a slot that a caller
+  // blocked here holds.
+  tbb::task_arena arena(std::max(1, tbb::this_task_arena::max_concurrency() - 1));
   std::thread reader([&] {
     try {
       arena.execute([&] {

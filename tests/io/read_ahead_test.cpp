@@ -3,6 +3,7 @@
 // it; a sink that throws stops the reader and its error is the one the caller gets.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/task_arena.h>
 
 #include <chrono>
@@ -79,6 +80,31 @@ TEST_F(ReadAhead, SameRunsAsScanPointsForAnyThreadCount) {
       EXPECT_EQ(report.declared, expected_report.declared);
     }
   }
+}
+
+// Two readings at once on the two threads of one arena (a library user's parallel loop) both
+// finish with their own runs: each reader has an arena of its own, so neither waits for a slot
+// that a caller blocked on its runs holds.
+TEST_F(ReadAhead, ConcurrentReadingsInOneArenaFinish) {
+  const fs::path ply = binary_ply("cloud.ply", 300'000, 300'000);
+  const fs::path text = text_cloud("cloud.xyz", 400'000);
+  g2s::ReadReport ply_report, text_report;
+  const Runs ply_runs = runs_of(g2s::io::scan_points, ply, ply_report);
+  const Runs text_runs = runs_of(g2s::io::scan_points, text, text_report);
+  Runs got_ply, got_text;
+  tbb::task_arena(2).execute([&] {
+    tbb::parallel_invoke(
+        [&] {
+          g2s::ReadReport report;
+          got_ply = runs_of(g2s::io::scan_points_ahead, ply, report);
+        },
+        [&] {
+          g2s::ReadReport report;
+          got_text = runs_of(g2s::io::scan_points_ahead, text, report);
+        });
+  });
+  EXPECT_EQ(got_ply, ply_runs);
+  EXPECT_EQ(got_text, text_runs);
 }
 
 TEST_F(ReadAhead, ReadersErrorComesAfterTheRunsBeforeIt) {
