@@ -287,7 +287,10 @@ class BodyReader {
       } else if (!e.has_lists()) {
         pos = fixed_rows_end(e, pos);
       } else {
-        for (std::uint64_t r = 0; r < e.count; ++r) pos = binary_row(e, pos, r, nullptr);
+        for (std::uint64_t r = 0; r < e.count; ++r) {
+          pos = binary_row(e, pos, r, nullptr);
+          if (r % kSkipRunRows == kSkipRunRows - 1) release_skipped(pos);
+        }
       }
       if (read_all(ei) && pos == size_ && rows_after(ei)) nothing_after(ei);
     }
@@ -340,6 +343,14 @@ class BodyReader {
       }
     }
     return kept;
+  }
+
+  // Rows of an element walked but not kept (a mesh's faces when only its points are read):
+  // streaming, the pages before them are released every this many, so that walking them does
+  // not hold the file in the resident set (a 260 MB face list took it from 31 to 283 MB).
+  static constexpr std::uint64_t kSkipRunRows = std::uint64_t{1} << 16;
+  void release_skipped(std::size_t consumed) const {
+    if (request_.points != nullptr) file_.release_before(consumed);
   }
 
   // Streaming: hands the points collected so far to the sink and releases the file's pages
@@ -556,6 +567,7 @@ class BodyReader {
       } else {
         for (std::uint64_t r = 0; r < e.count; ++r) {
           if (!lines.next_nonblank(line)) ascii_truncated(lines, e, r);
+          if (r % kSkipRunRows == kSkipRunRows - 1) release_skipped(lines.position());
         }
       }
       if (read_all(ei) && rows_after(ei) && !lines.has_nonblank()) nothing_after(ei);
