@@ -247,33 +247,26 @@ class BodyReader {
     return pos + static_cast<std::size_t>(e.count * stride);
   }
 
-  // The file ends right after the elements read, but the header declares more (with rows):
-  // a file cut short there, said as such.
-  [[noreturn]] void nothing_after(std::size_t ei) const {
-    for (std::size_t later = ei + 1; later < header_.elements.size(); ++later) {
-      const PlyElement& missing = header_.elements[later];
-      if (missing.count > 0) {
-        fail_input(name_,
-                   "file ends after the {}, but the header declares {} {} after them (line {}; "
-                   "truncated file?)",
-                   header_.elements[ei].name == "vertex" ? "vertices" : header_.elements[ei].name,
-                   missing.count, missing.name, missing.line);
-      }
-    }
-    fail_input(name_, "file ends early");  // unreachable: only called with rows still declared
+  // The first element after `ei` that declares rows, or the element count.
+  std::size_t next_with_rows(std::size_t ei) const {
+    std::size_t later = ei + 1;
+    while (later < header_.elements.size() && header_.elements[later].count == 0) ++later;
+    return later;
   }
-  // Whether an element after `ei` declares rows.
-  bool rows_after(std::size_t ei) const {
-    for (std::size_t later = ei + 1; later < header_.elements.size(); ++later) {
-      if (header_.elements[later].count > 0) return true;
-    }
-    return false;
-  }
-  // The elements after those read are walked too, without keeping anything, so that a file cut
-  // short anywhere in its declared body is reported (a mesh's faces cut in the middle), and the
-  // bytes after the body are known.
-  bool read_all(std::size_t ei) const {
-    return static_cast<int>(ei) >= vertex_.element && static_cast<int>(ei) >= face_.element;
+  // After the last element read (`ei`): the elements after it are walked too, without keeping
+  // anything, so that a file cut short anywhere in its declared body is reported (a mesh's faces
+  // cut in the middle) and the bytes after the body are known. A file that ends right here while
+  // the header declares more rows is said to end after this element.
+  void check_rest(std::size_t ei, bool at_end) const {
+    if (static_cast<int>(ei) < vertex_.element || static_cast<int>(ei) < face_.element) return;
+    const std::size_t missing = next_with_rows(ei);
+    if (!at_end || missing == header_.elements.size()) return;
+    const PlyElement& e = header_.elements[ei];
+    const PlyElement& m = header_.elements[missing];
+    fail_input(name_,
+               "file ends after the {}, but the header declares {} {} after them (line {}; "
+               "truncated file?)",
+               e.name == "vertex" ? "vertices" : e.name, m.count, m.name, m.line);
   }
 
   void run_binary() {
@@ -292,7 +285,7 @@ class BodyReader {
           if (r % kSkipRunRows == kSkipRunRows - 1) release_skipped(pos);
         }
       }
-      if (read_all(ei) && pos == size_ && rows_after(ei)) nothing_after(ei);
+      check_rest(ei, pos == size_);
     }
     result_.end = pos;
   }
@@ -570,7 +563,7 @@ class BodyReader {
           if (r % kSkipRunRows == kSkipRunRows - 1) release_skipped(lines.position());
         }
       }
-      if (read_all(ei) && rows_after(ei) && !lines.has_nonblank()) nothing_after(ei);
+      check_rest(ei, !lines.has_nonblank());
     }
     result_.end = lines.position();
   }
