@@ -23,7 +23,8 @@ std::string why_no_surface(const PointCloud& cloud);
 
 // The same for `n` points visited by `each`, which calls its argument with runs of points (x,
 // y, z each) holding every point, in the same order each time, e.g. a tile store's tiles loaded
-// one at a time. Real clouds take three passes; a line or nearly one up to seven and a copy.
+// one at a time. Real clouds take one pass (four points on it that no line holds three of
+// settle them); a line or nearly one up to seven and a copy.
 using PointRun = std::function<void(std::span<const double>)>;
 using PointVisitor = std::function<void(const PointRun&)>;
 std::string why_no_surface(std::uint64_t n, const PointVisitor& each);

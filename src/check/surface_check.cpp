@@ -99,6 +99,28 @@ bool maybe_collinear(const Point& p, const Point& q, const Point& r, double tole
          4.0 * tolerance * longest;
 }
 
+// Whether four of `points` have no three within `tolerance` of one line: no three may lie on
+// one (maybe_collinear says no for each of the four triples). Three points within t of a line
+// have a height of at most 2t over their longest side, so twice their area is at most 2t times
+// that side, half of what maybe_collinear allows; every line then misses two of the four.
+bool four_off_every_line(std::span<const Point> points, double tolerance) {
+  const std::size_t n = points.size();
+  const auto apart = [&](std::size_t i, std::size_t j, std::size_t k) {
+    return !maybe_collinear(points[i], points[j], points[k], tolerance);
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = i + 1; j < n; ++j) {
+      for (std::size_t k = j + 1; k < n; ++k) {
+        if (!apart(i, j, k)) continue;
+        for (std::size_t l = k + 1; l < n; ++l) {
+          if (apart(i, j, l) && apart(i, k, l) && apart(j, k, l)) return true;
+        }
+      }
+    }
+  }
+  return false;
+}
+
 std::size_t count_distinct(const PointVisitor& each, std::uint64_t n) {
   std::vector<Point> points;
   points.reserve(n);
@@ -144,20 +166,31 @@ std::string why_no_surface(std::uint64_t n, const PointVisitor& each) {
   // The bounds, and the point farthest from the first one, in one pass. Two sweeps of "farthest
   // point" give two points nearly a diameter apart: the line through them is the candidate for
   // a line holding every point.
+  // The pass also keeps the first point reaching each bound: with the first point and the
+  // farthest, eight points that settle a real cloud at once (below).
   Point first{};
   bool have_first = false;
   Point a{};
   double a_d2 = -1.0;
+  std::array<Point, 8> extremes{};  // lowest x, y, z, highest x, y, z, first, farthest
   for_each_point(each, [&](const Point& p) {
     if (!have_first) first = p, have_first = true;
     for (int axis = 0; axis < 3; ++axis) {
-      lo[axis] = std::min(lo[axis], p[axis]);
-      hi[axis] = std::max(hi[axis], p[axis]);
+      if (p[axis] < lo[axis]) lo[axis] = p[axis], extremes[axis] = p;
+      if (p[axis] > hi[axis]) hi[axis] = p[axis], extremes[3 + axis] = p;
     }
     const double d2 = distance2(p, first);
     if (d2 > a_d2) a = p, a_d2 = d2;
   });
   if (std::string why = why_beyond_float(lo, hi); !why.empty()) return why;
+  // Every line test below has a tolerance of a millionth of the length between two points, no
+  // more than a millionth of the box's diagonal. Four points of which no line within that holds
+  // three leave two points off every such line, stray or not: the answer is "" without the
+  // further passes.
+  extremes[6] = first;
+  extremes[7] = a;
+  const double diagonal = std::sqrt(distance2({lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}));
+  if (four_off_every_line(extremes, 1e-6 * diagonal)) return "";
   const Point b = farthest_from(each, a);
   const double length2 = distance2(a, b);
   if (length2 == 0.0) {

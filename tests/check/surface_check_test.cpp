@@ -84,4 +84,30 @@ TEST(SurfaceCheck, ThinStripAndFlatCloudCanMakeASurface) {
   EXPECT_EQ(why_no_surface(flat), "");
 }
 
+// The passes over a tile store are the check's cost before meshing: a real cloud is settled by
+// the first pass, and a line with one stray point still takes the passes that find the stray.
+TEST(SurfaceCheck, RealCloudTakesOnePass) {
+  PointCloud flat;
+  for (int i = 0; i < 100; ++i) {
+    for (int j = 0; j < 100; ++j) flat.xyz.insert(flat.xyz.end(), {i * 1.0, j * 1e-3, 7.0});
+  }
+  PointCloud stray;
+  for (int i = 0; i < 100; ++i) stray.xyz.insert(stray.xyz.end(), {i * 1.0, 2.0 * i, 3.0});
+  stray.xyz.insert(stray.xyz.end(), {50.0, 0.0, 3.0});
+  const auto passes = [](const PointCloud& cloud, std::string& why) {
+    int count = 0;
+    why = why_no_surface(cloud.size(), [&](const g2s::PointRun& visit) {
+      ++count;
+      visit(cloud.xyz);
+    });
+    return count;
+  };
+  std::string why;
+  EXPECT_EQ(passes(flat, why), 1);
+  EXPECT_EQ(why, "");
+  EXPECT_GT(passes(stray, why), 1);
+  EXPECT_TRUE(says(why, "lie on one straight line")) << why;
+  EXPECT_TRUE(says(why, "but the one at (50, 0, 3)")) << why;
+}
+
 }  // namespace
