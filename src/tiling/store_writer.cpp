@@ -565,9 +565,8 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
     std::vector<TileSpacing> spacing(round_end - round_begin);
     tbb::parallel_for(round_begin, round_end, [&](std::size_t t) {
       const std::size_t begin = tile_start[t] - base, n = counts[leaves[t]];
-      spacing[t - round_begin] = measure_tile_spacing(xyz.subspan(3 * begin, 3 * n),
-                                                      ids.subspan(begin, n), tree.box(leaves[t]),
-                                                      bounds, total);
+      spacing[t - round_begin] = measure_tile_spacing(
+          xyz.subspan(3 * begin, 3 * n), ids.subspan(begin, n), tree.box(leaves[t]), bounds, total);
     });
     for (const TileSpacing& s : spacing) {
       cloud_sample.insert(cloud_sample.end(), s.cloud_sample.begin(), s.cloud_sample.end());
@@ -576,9 +575,9 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
       const std::uint32_t node = leaves[t];
       const std::size_t begin = tile_start[t] - base;
       const std::size_t n = counts[node];
-      const BlockEntry block = write_block(file, xyz.subspan(3 * begin, 3 * n),
-                                           ids.subspan(begin, n), tree.box(node), bounds, options,
-                                           scratch);
+      const BlockEntry block =
+          write_block(file, xyz.subspan(3 * begin, 3 * n), ids.subspan(begin, n), tree.box(node),
+                      bounds, options, scratch);
       unsigned char* e = table.data() + t * kEntryBytes;
       for (int a = 0; a < 3; ++a) {
         store_le(e + entry::box + 8 * a, tree.box(node).lo[a]);
