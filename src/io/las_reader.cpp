@@ -183,7 +183,7 @@ std::size_t convert_records(const unsigned char* base, std::size_t stride, std::
 
 }  // namespace
 
-PointCloud read_las_points(const MappedFile& file, ReadReport& report, const PointSink* sink) {
+PointCloud read_las_points(const MappedFile& file, ReadReport& report, const RunSink* sink) {
   const LasHeader h = parse_las_header(file);
   report.format = fmt::format("las-1.{}-format{}", h.minor, h.format);
   report.declared = h.count;

@@ -80,7 +80,7 @@ struct PlyBodyRequest {
   std::vector<Triangle>* faces = nullptr;  // meshes: the face element, fanned into triangles
   // Streaming: the vertices go to this sink, at most kScanChunkPoints at a time, instead of
   // into the result, and the pages read are released as the body is consumed.
-  const PointSink* points = nullptr;
+  const RunSink* points = nullptr;
 };
 
 struct PlyBodyResult {

@@ -350,8 +350,8 @@ class BodyReader {
   // before `consumed`. Collecting: nothing to do.
   void emit(std::size_t consumed) {
     if (request_.points == nullptr) return;
-    if (!result_.xyz.empty()) (*request_.points)(result_.xyz);
     result_.streamed += result_.xyz.size() / 3;
+    if (!result_.xyz.empty()) (*request_.points)(result_.xyz);
     result_.xyz.clear();
     file_.release_before(consumed);
   }

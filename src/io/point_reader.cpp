@@ -29,7 +29,7 @@ std::uint64_t bytes_holding_data(const MappedFile& file, std::size_t end, bool a
 }
 
 // Reads `file` into the returned cloud (sink == nullptr) or streams it to the sink.
-PointCloud read_or_scan(const MappedFile& file, const PointSink* sink, ReadReport& r) {
+PointCloud read_or_scan(const MappedFile& file, const RunSink* sink, ReadReport& r) {
   r = ReadReport{};
   if (file.size() == 0) {
     fail_input(file.name(), "file is empty (expected a PLY, LAS or XYZ/PTS point cloud)");
@@ -72,9 +72,14 @@ PointCloud read_points_from(const MappedFile& file, ReadReport& report) {
   return read_or_scan(file, nullptr, report);
 }
 
-void scan_points(const std::filesystem::path& path, const PointSink& sink, ReadReport& report) {
+void scan_runs(const std::filesystem::path& path, const RunSink& sink, ReadReport& report) {
   const MappedFile file(path, MapMode::stream);
   read_or_scan(file, &sink, report);
+}
+
+void scan_points(const std::filesystem::path& path, const PointSink& sink, ReadReport& report) {
+  scan_runs(
+      path, [&sink](std::vector<double>& xyz) { sink(xyz); }, report);
 }
 
 }  // namespace io

@@ -111,7 +111,7 @@ bool has_decimal_commas(std::string_view line) {
 
 }  // namespace
 
-PointCloud read_xyz_points(const MappedFile& file, ReadReport& report, const PointSink* sink) {
+PointCloud read_xyz_points(const MappedFile& file, ReadReport& report, const RunSink* sink) {
   report.format = "xyz";
   report.declared = 0;
   std::string_view text = file.view();
@@ -189,7 +189,7 @@ PointCloud read_xyz_points(const MappedFile& file, ReadReport& report, const Poi
       tbb::parallel_for(std::size_t{0}, chunks.size(),
                         [&](std::size_t i) { parse_chunk(chunks[i]); });
     }
-    for (const Chunk& c : chunks) {
+    for (Chunk& c : chunks) {
       if (c.failed) fail_input(file.name(), "line {}: {}", line + c.lines, c.error);
       line += c.lines;
       report.non_finite += c.non_finite;
