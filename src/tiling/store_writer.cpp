@@ -189,17 +189,20 @@ class SpillFile {
   // Bytes [offset, offset + bytes) of the written spill, mapped read-only until the view goes.
   // They are the page cache's pages that the spill pass wrote: a round reads its points without
   // a copy and without fresh memory (a buffer to read them into must first be zeroed by the
-  // kernel: 0.33 s of one thread for the 20M torus's 224 MB round on the 2-vCPU VM).
+  // kernel: 0.33 s of one thread for the 20M torus's 224 MB round on the 2-vCPU VM). Where the
+  // file system cannot map the file (some FUSE mounts), they are read into a buffer instead.
   class View {
    public:
     View() = default;
     View(void* mapping, std::size_t length, std::size_t skip)
         : mapping_(mapping), length_(length), skip_(skip) {}
+    explicit View(std::unique_ptr<char[]> copy) : copy_(std::move(copy)) {}
     View(View&& other) noexcept { *this = std::move(other); }
     View& operator=(View&& other) noexcept {
       std::swap(mapping_, other.mapping_);
       std::swap(length_, other.length_);
       std::swap(skip_, other.skip_);
+      std::swap(copy_, other.copy_);
       return *this;
     }
     View(const View&) = delete;
@@ -209,13 +212,15 @@ class SpillFile {
     }
     template <class T>
     std::span<const T> as(std::size_t count) const {
-      if (mapping_ == nullptr) return {};
-      return {reinterpret_cast<const T*>(static_cast<const char*>(mapping_) + skip_), count};
+      const char* bytes = copy_ ? copy_.get() : static_cast<const char*>(mapping_) + skip_;
+      if (bytes == nullptr) return {};
+      return {reinterpret_cast<const T*>(bytes), count};
     }
 
    private:
     void* mapping_ = nullptr;
     std::size_t length_ = 0, skip_ = 0;
+    std::unique_ptr<char[]> copy_;  // the bytes read, where they could not be mapped
   };
   View view(std::uint64_t offset, std::size_t bytes) const {
     if (bytes == 0) return {};
@@ -223,8 +228,17 @@ class SpillFile {
     const std::uint64_t start = offset / page * page;
     const std::size_t length = bytes + static_cast<std::size_t>(offset - start);
     void* mapping = ::mmap(nullptr, length, PROT_READ, MAP_SHARED, fd_, static_cast<off_t>(start));
-    if (mapping == MAP_FAILED) fail("cannot map the spill file");
-    return {mapping, length, static_cast<std::size_t>(offset - start)};
+    if (mapping != MAP_FAILED) return {mapping, length, static_cast<std::size_t>(offset - start)};
+    auto copy = std::make_unique_for_overwrite<char[]>(bytes);
+    for (std::size_t done = 0; done < bytes;) {
+      const ssize_t n =
+          ::pread(fd_, copy.get() + done, bytes - done, static_cast<off_t>(offset + done));
+      if (n < 0 && errno == EINTR) continue;
+      if (n == 0) errno = EIO;
+      if (n <= 0) fail("cannot read back the spill file");
+      done += static_cast<std::size_t>(n);
+    }
+    return View(std::move(copy));
   }
 
  private:
