@@ -1,7 +1,7 @@
 // libFuzzer target: the LAS point reader behind read_points (header checks, VLR walk for the
 // LASzip marker, counts, record stride, scale and offset), collected and streamed. Inputs without
 // the "LASF" signature are left to the other readers' targets.
-#include <span>
+#include <vector>
 
 #include "fuzz_input.hpp"
 #include "io/readers.hpp"
@@ -15,7 +15,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   });
   return g2s::fuzz::expect_clean_refusal([&] {
     g2s::ReadReport report;
-    const g2s::io::PointSink sink = [](std::span<const double>) {};
+    // The sink takes each run's vector, as the read-ahead does: the reader refills another.
+    const g2s::io::RunSink sink = [](std::vector<double>& xyz) { std::vector<double>{}.swap(xyz); };
     g2s::io::read_las_points(file, report, &sink);
   });
 }
