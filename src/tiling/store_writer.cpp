@@ -9,7 +9,6 @@
 // bytes do not depend on round_points, threads or timing.
 #include <fcntl.h>
 #include <fmt/core.h>
-#include <sys/mman.h>
 #include <sys/stat.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -186,62 +185,24 @@ class SpillFile {
       fail("cannot write the spill file", err);
     }
   }
-  // Bytes [offset, offset + bytes) of the written spill, mapped read-only until the view goes.
-  // They are the page cache's pages that the spill pass wrote: a round reads its points without
-  // a copy and without fresh memory (a buffer to read them into must first be zeroed by the
-  // kernel: 0.33 s of one thread for the 20M torus's 224 MB round on the 2-vCPU VM). Where the
-  // file system cannot map the file (some FUSE mounts), they are read into a buffer instead.
-  class View {
-   public:
-    View() = default;
-    View(void* mapping, std::size_t length, std::size_t skip)
-        : mapping_(mapping), length_(length), skip_(skip) {}
-    explicit View(std::unique_ptr<char[]> copy) : copy_(std::move(copy)) {}
-    View(View&& other) noexcept { *this = std::move(other); }
-    View& operator=(View&& other) noexcept {
-      std::swap(mapping_, other.mapping_);
-      std::swap(length_, other.length_);
-      std::swap(skip_, other.skip_);
-      std::swap(copy_, other.copy_);
-      return *this;
-    }
-    View(const View&) = delete;
-    View& operator=(const View&) = delete;
-    ~View() {
-      if (mapping_ != nullptr) ::munmap(mapping_, length_);
-    }
-    template <class T>
-    std::span<const T> as(std::size_t count) const {
-      const char* bytes = copy_ ? copy_.get() : static_cast<const char*>(mapping_) + skip_;
-      if (bytes == nullptr) return {};
-      return {reinterpret_cast<const T*>(bytes), count};
-    }
-
-   private:
-    void* mapping_ = nullptr;
-    std::size_t length_ = 0, skip_ = 0;
-    std::unique_ptr<char[]> copy_;  // the bytes read, where they could not be mapped
-  };
-  View view(std::uint64_t offset, std::size_t bytes) const {
-    if (bytes == 0) return {};
-    const auto page = static_cast<std::uint64_t>(::sysconf(_SC_PAGESIZE));
-    const std::uint64_t start = offset / page * page;
-    const std::size_t length = bytes + static_cast<std::size_t>(offset - start);
-    void* mapping = ::mmap(nullptr, length, PROT_READ, MAP_SHARED, fd_, static_cast<off_t>(start));
-    if (mapping != MAP_FAILED) return {mapping, length, static_cast<std::size_t>(offset - start)};
-    auto copy = std::make_unique_for_overwrite<char[]>(bytes);
-    for (std::size_t done = 0; done < bytes;) {
-      const ssize_t n =
-          ::pread(fd_, copy.get() + done, bytes - done, static_cast<off_t>(offset + done));
-      if (n < 0 && errno == EINTR) continue;
-      if (n == 0) errno = EIO;
-      if (n <= 0) fail("cannot read back the spill file");
-      done += static_cast<std::size_t>(n);
-    }
-    return View(std::move(copy));
+  void read_at(std::uint64_t offset, void* data, std::size_t bytes) const {
+    whole(::pread, static_cast<char*>(data), bytes, offset, "cannot read back the spill file");
   }
 
  private:
+  // Calls pwrite or pread until all `bytes` are done (they may do less, or be interrupted).
+  template <class Call, class Byte>
+  void whole(Call call, Byte* p, std::size_t bytes, std::uint64_t offset, const char* what) const {
+    while (bytes > 0) {
+      const ssize_t n = call(fd_, p, bytes, static_cast<off_t>(offset));
+      if (n < 0 && errno == EINTR) continue;
+      if (n == 0) errno = EIO;
+      if (n <= 0) fail(what);
+      p += n;
+      bytes -= static_cast<std::size_t>(n);
+      offset += static_cast<std::uint64_t>(n);
+    }
+  }
   [[noreturn]] void fail(const char* what, int err = errno) const {
     throw Error(Exit::write_failed,
                 fmt::format("{}: {}: {}", target_.string(), what, std::strerror(err)));
@@ -536,29 +497,20 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
 
   BlockScratch scratch;
   std::vector<NearestThree> cloud_sample;
-  // One round's points, read from the input into buffers that the pass fills whole (so they
-  // are not cleared first); several rounds' are views of the spill.
-  std::unique_ptr<double[]> read_xyz;
-  std::unique_ptr<Index[]> read_ids;
-  if (!spill) {
-    read_xyz = std::make_unique_for_overwrite<double[]>(largest_round * 3);
-    read_ids = std::make_unique_for_overwrite<Index[]>(largest_round);
-  }
+  // A round's points: the spill's reads or the pass fill them whole, so they are not cleared
+  // first (a pass over 28 bytes a point, 224 MB at the default round).
+  const auto xyz = std::make_unique_for_overwrite<double[]>(largest_round * 3);
+  const auto ids = std::make_unique_for_overwrite<Index[]>(largest_round);
   std::uint64_t written = 0;
   for (std::size_t round = 0; round + 1 < round_first.size(); ++round) {
     const std::size_t round_begin = round_first[round];
     const std::size_t round_end = round_first[round + 1];
     const std::uint64_t base = tile_start[round_begin];  // the round's first point in tile order
-    const std::size_t round_size = tile_start[round_end] - base;
-    SpillFile::View xyz_view, ids_view;
-    std::span<const double> xyz;
-    std::span<const Index> ids;
     if (spill) {
-      xyz_view = spill->view(3 * sizeof(double) * base, 3 * sizeof(double) * round_size);
-      ids_view = spill->view(3 * sizeof(double) * total + sizeof(Index) * base,
-                             sizeof(Index) * round_size);
-      xyz = xyz_view.as<double>(3 * round_size);
-      ids = ids_view.as<Index>(round_size);
+      const std::size_t n = tile_start[round_end] - base;
+      spill->read_at(3 * sizeof(double) * base, xyz.get(), 3 * sizeof(double) * n);
+      spill->read_at(3 * sizeof(double) * total + sizeof(Index) * base, ids.get(),
+                     sizeof(Index) * n);
     } else {
       std::vector<std::uint64_t> cursor(tile_start.begin() + round_begin,
                                         tile_start.begin() + round_end);
@@ -567,12 +519,10 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
         if (t < round_begin || t >= round_end) return;
         const std::uint64_t at = cursor[t - round_begin]++;
         if (at == tile_start[t + 1]) throw_changed(input);  // before overrunning
-        std::copy_n(p, 3, &read_xyz[3 * (at - base)]);
-        read_ids[at - base] = static_cast<Index>(id);
+        std::copy_n(p, 3, &xyz[3 * (at - base)]);
+        ids[at - base] = static_cast<Index>(id);
       });
       check_unchanged(input, first, again);
-      xyz = {read_xyz.get(), 3 * round_size};
-      ids = {read_ids.get(), round_size};
     }
     // The spacing estimates of the round's tiles, in parallel (each is a serial pass over its
     // tile); the blocks are then written one by one, each encoded in parallel.
@@ -580,7 +530,8 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
     tbb::parallel_for(round_begin, round_end, [&](std::size_t t) {
       const std::size_t begin = tile_start[t] - base, n = counts[leaves[t]];
       spacing[t - round_begin] = measure_tile_spacing(
-          xyz.subspan(3 * begin, 3 * n), ids.subspan(begin, n), tree.box(leaves[t]), bounds, total);
+          std::span<const double>(xyz.get() + 3 * begin, 3 * n),
+          std::span<const Index>(ids.get() + begin, n), tree.box(leaves[t]), bounds, total);
     });
     for (const TileSpacing& s : spacing) {
       cloud_sample.insert(cloud_sample.end(), s.cloud_sample.begin(), s.cloud_sample.end());
@@ -589,8 +540,9 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
       const std::uint32_t node = leaves[t];
       const std::size_t begin = tile_start[t] - base;
       const std::size_t n = counts[node];
+      const std::span<const double> tile_xyz(xyz.get() + 3 * begin, 3 * n);
       const BlockEntry block =
-          write_block(file, xyz.subspan(3 * begin, 3 * n), ids.subspan(begin, n), tree.box(node),
+          write_block(file, tile_xyz, std::span<const Index>(ids.get() + begin, n), tree.box(node),
                       bounds, options, scratch);
       unsigned char* e = table.data() + t * kEntryBytes;
       for (int a = 0; a < 3; ++a) {
