@@ -955,15 +955,26 @@ class Grower {
   // Widens a hole that could not be filled by the ring of triangles around it: the triangles
   // outside its loop join the ring, holes the ring reaches join the hole, and the loop becomes
   // the border of them all. Where that border would pass a point twice, the point's whole fan
-  // joins the ring too. Gives up (false, attempt unusable) where the ring would take a triangle
-  // at a point that is not fillable, would reach a piece's outer border or a hole already filled,
-  // or where the border would have more than max_edges edges.
+  // joins the ring too; where it would run in more than one loop (the ring closes around a pocket
+  // of triangles not in it), the triangles outside every loop but the longest join the ring, so
+  // that the pocket goes with it. Gives up (false, attempt unusable) where the ring would take a
+  // triangle at a point that is not fillable, would reach a piece's outer border or a hole
+  // already filled, or where the border would have more than max_edges edges.
   bool widen(const detail::TriangleCells& cells, Attempt& attempt, const HoleIndex& holes,
              const std::vector<std::uint8_t>& dead, std::size_t max_edges) {
     std::vector<std::uint32_t>& ring = attempt.ring;
     ring.insert(ring.end(), attempt.outside.begin(), attempt.outside.end());
     const std::size_t merged_before = attempt.merged.size();
     std::vector<Border>& border = border_;
+    // The border edge leaving point v (border sorted by `from`, each point once), or
+    // border.size().
+    const auto leaving = [&](Index v) {
+      const auto it = std::lower_bound(border.begin(), border.end(), v,
+                                       [](const Border& e, Index from) { return e.from < from; });
+      return it != border.end() && it->from == v ? static_cast<std::size_t>(it - border.begin())
+                                                 : border.size();
+    };
+    std::uint32_t outer = 0;  // the longest of the border's loops
     for (int pass = 0;; ++pass) {
       std::sort(ring.begin(), ring.end());
       ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
@@ -976,48 +987,66 @@ class Grower {
       for (std::size_t k = 1; k < border.size(); ++k) {
         if (border[k].from == border[k - 1].from) pinched_.push_back(border[k].from);
       }
-      if (pinched_.empty()) break;
-      if (pass == kMaxPinchPasses) return false;
-      for (const Index v : pinched_) {
-        const Vec3f& p = grid_.point(v);
-        cells.for_each_near(p, p, [&](std::uint32_t t, const detail::Box&) {
-          const Triangle& tri = triangles_[t];
-          if (!dead[t] && std::find(tri.begin(), tri.end(), v) != tri.end()) ring.push_back(t);
-        });
+      if (!pinched_.empty()) {
+        if (pass == kMaxWidenPasses) return false;
+        for (const Index v : pinched_) {
+          const Vec3f& p = grid_.point(v);
+          cells.for_each_near(p, p, [&](std::uint32_t t, const detail::Box&) {
+            const Triangle& tri = triangles_[t];
+            if (!dead[t] && std::find(tri.begin(), tri.end(), v) != tri.end()) ring.push_back(t);
+          });
+        }
+        continue;
+      }
+      // The triangles outside the ring's border edges, among those near it.
+      detail::Box box{grid_.point(border[0].from), grid_.point(border[0].from)};
+      for (const Border& e : border) box = detail::enclose(box, grid_.point(e.from));
+      cells.for_each_near(box.lo, box.hi, [&](std::uint32_t t, const detail::Box&) {
+        if (dead[t] || attempt.in_ring(t)) return;
+        const Triangle& tri = triangles_[t];
+        for (Border& e : border) {
+          if (e.outside == kNoIndex && std::find(tri.begin(), tri.end(), e.from) != tri.end() &&
+              std::find(tri.begin(), tri.end(), e.to) != tri.end()) {
+            e.outside = t;
+          }
+        }
+      });
+      // The border's loops: each edge goes on by the edge leaving its end.
+      border_loop_.assign(border.size(), kNoIndex);
+      std::uint32_t loops = 0, outer_edges = 0;
+      for (std::size_t start = 0; start < border.size(); ++start) {
+        if (border_loop_[start] != kNoIndex) continue;
+        std::uint32_t edges = 0;
+        std::size_t k = start;
+        do {
+          if (border[k].outside == kNoIndex) return false;
+          border_loop_[k] = loops;
+          ++edges;
+          k = leaving(border[k].to);
+          if (k == border.size() || (k != start && border_loop_[k] != kNoIndex)) return false;
+        } while (k != start);
+        if (edges > outer_edges) outer = loops, outer_edges = edges;
+        ++loops;
+      }
+      if (loops == 1) break;
+      if (pass == kMaxWidenPasses) return false;
+      for (std::size_t k = 0; k < border.size(); ++k) {
+        if (border_loop_[k] != outer) ring.push_back(border[k].outside);
       }
     }
-    // The triangles outside the ring's border edges, among those near it.
-    detail::Box box{grid_.point(border[0].from), grid_.point(border[0].from)};
-    for (const Border& e : border) box = detail::enclose(box, grid_.point(e.from));
-    cells.for_each_near(box.lo, box.hi, [&](std::uint32_t t, const detail::Box&) {
-      if (dead[t] || attempt.in_ring(t)) return;
-      const Triangle& tri = triangles_[t];
-      for (Border& e : border) {
-        if (e.outside == kNoIndex && std::find(tri.begin(), tri.end(), e.from) != tri.end() &&
-            std::find(tri.begin(), tri.end(), e.to) != tri.end()) {
-          e.outside = t;
-        }
-      }
-    });
-    // Chain the border edges (sorted by `from`, each point once) into one loop.
-    const auto leaving = [&](Index v) {
-      const auto it = std::lower_bound(border.begin(), border.end(), v,
-                                       [](const Border& e, Index from) { return e.from < from; });
-      return it != border.end() && it->from == v ? static_cast<std::size_t>(it - border.begin())
-                                                 : border.size();
-    };
+    // The loop, chained from the outer loop's first edge.
     attempt.loop.clear();
     attempt.outside.clear();
     attempt.around.clear();
-    std::size_t k = 0;
+    const auto first = static_cast<std::size_t>(
+        std::find(border_loop_.begin(), border_loop_.end(), outer) - border_loop_.begin());
+    std::size_t k = first;
     do {
       const Border& e = border[k];
-      if (e.outside == kNoIndex) return false;
       attempt.add_edge(e.from, e.outside, facing_normal(e.outside));
       k = leaving(e.to);
-      if (k == border.size() || attempt.loop.size() > border.size()) return false;
-    } while (k != 0);
-    return attempt.loop.size() == border.size();
+    } while (k != first);
+    return true;
   }
 
   // The border of the attempt's ring and holes (border_, unordered): ring edges with a triangle
@@ -1555,8 +1584,10 @@ class Grower {
   // A mark for compact: off the Point-Edge Map already (any other non-zero mark: removed with its
   // edges).
   static constexpr std::uint8_t kUnlinked = 2;
-  // How many times a widened border that passes a point twice may take in that point's fan.
-  static constexpr int kMaxPinchPasses = 3;
+  // How many times a widened border may take in more triangles before it is one loop through
+  // each of its points once: the fans of points it passes twice, the pockets it closes around.
+  // More made no difference on the shared scans (16: raw-bunny 674 holes against 675).
+  static constexpr int kMaxWidenPasses = 8;
   // How far (in spacings) from the surface a point that a widened filling or a scrap leaves out
   // may lie: noise spreads a scan's points over a layer a few spacings thick, and the points
   // farther out stay vertices.
@@ -1592,7 +1623,8 @@ class Grower {
     Index from, to;
     std::uint32_t outside;
   };
-  std::vector<Border> border_;  // widen's scratch
+  std::vector<Border> border_;              // widen's scratch
+  std::vector<std::uint32_t> border_loop_;  // widen's: per border edge, its loop
   std::vector<std::pair<std::uint64_t, Border>> ring_edges_;
   std::vector<Index> pinched_;
   std::vector<Index> loop_;  // try_fill's loop and normals
