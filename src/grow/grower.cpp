@@ -974,7 +974,8 @@ class Grower {
       return it != border.end() && it->from == v ? static_cast<std::size_t>(it - border.begin())
                                                  : border.size();
     };
-    std::uint32_t outer = 0;  // the longest of the border's loops
+    std::uint32_t outer = 0;      // the longest of the border's loops
+    std::size_t outer_start = 0;  // and an edge of it
     for (int pass = 0;; ++pass) {
       std::sort(ring.begin(), ring.end());
       ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
@@ -1025,7 +1026,7 @@ class Grower {
           k = leaving(border[k].to);
           if (k == border.size() || (k != start && border_loop_[k] != kNoIndex)) return false;
         } while (k != start);
-        if (edges > outer_edges) outer = loops, outer_edges = edges;
+        if (edges > outer_edges) outer = loops, outer_edges = edges, outer_start = start;
         ++loops;
       }
       if (loops == 1) break;
@@ -1038,14 +1039,12 @@ class Grower {
     attempt.loop.clear();
     attempt.outside.clear();
     attempt.around.clear();
-    const auto first = static_cast<std::size_t>(
-        std::find(border_loop_.begin(), border_loop_.end(), outer) - border_loop_.begin());
-    std::size_t k = first;
+    std::size_t k = outer_start;
     do {
       const Border& e = border[k];
       attempt.add_edge(e.from, e.outside, facing_normal(e.outside));
       k = leaving(e.to);
-    } while (k != first);
+    } while (k != outer_start);
     return true;
   }
 
