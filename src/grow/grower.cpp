@@ -343,20 +343,22 @@ class Grower {
   // corner on an open edge, so not a surface patch of their own) and lie within
   // kMaxLeftOutDistance spacings of a piece that stays for its own sake at every corner: on a
   // noisy scan they are triangles grown in the layer beside the sheet, each a separate hole.
-  // Only pieces grown in this run at points it judges (fillable) go; their points are left out,
-  // as widened holes leave out points near the surface. Scraps near only other scraps are not
-  // near a surface (the corners of a cube give two opposite faces, each a scrap): they stay.
+  // Only pieces whose every point this run judges (fillable) go, whether grown here or loaded
+  // (a seam sees every triangle at its band's points, so such a piece is whole there: a tile
+  // keeps a piece that reaches into its halo, and the seam judges what is left of it once the
+  // halo's triangles are dropped); their points are left out, as widened holes leave out points
+  // near the surface. Scraps near only other scraps are not near a surface (the corners of a
+  // cube give two opposite faces, each a scrap): they stay.
   void remove_scraps() {
     const auto n = static_cast<std::uint32_t>(grid_.size());
     const std::vector<std::uint32_t> piece = pieces();
-    // A piece may go unless it has an interior point (one on no open edge), a triangle loaded
-    // before the run or a point this run does not judge.
+    // A piece may go unless it has an interior point (one on no open edge) or a point this run
+    // does not judge.
     std::vector<std::uint8_t> on_open(n, 0), keep(n, 0);
     edges_.for_each_open([&](Index u, Index v) { on_open[u] = on_open[v] = 1; });
     for (std::uint32_t v = 0; v < n; ++v) {
       if (piece[v] != kNoIndex && (!on_open[v] || !fillable(v))) keep[piece[v]] = 1;
     }
-    for (std::size_t t = 0; t < preloaded_; ++t) keep[piece[triangles_[t][0]]] = 1;
     const double radius = kMaxLeftOutDistance * grid_.spacing();
     const std::vector<std::uint8_t> patch = keep;  // the pieces that stay for their own sake
     for (std::uint32_t v = 0; v < n; ++v) {
@@ -369,9 +371,15 @@ class Grower {
     }
     std::vector<std::uint8_t> dead(triangles_.size(), 0);
     bool any = false;
-    for (std::size_t t = preloaded_; t < triangles_.size(); ++t) {
-      dead[t] = !keep[piece[triangles_[t][0]]];
-      any = any || dead[t];
+    for (std::size_t t = 0; t < triangles_.size(); ++t) {
+      if (keep[piece[triangles_[t][0]]]) continue;
+      any = true;
+      dead[t] = 1;
+      if (t >= preloaded_) continue;
+      // A loaded triangle goes as a widened ring's does: off the map here, listed in the result.
+      const Triangle& tri = triangles_[t];
+      for (int k = 0; k < 3; ++k) edges_.remove(tri[k], tri[(k + 1) % 3]);
+      dead[t] = kUnlinked;
     }
     if (any) compact(std::move(dead));
   }
@@ -598,9 +606,9 @@ class Grower {
 
   // Removes the triangles marked dead, and their edges from the Point-Edge Map (a triangle marked
   // kUnlinked is off the map already). A triangle loaded before the run goes only as part of a
-  // widened hole's ring (kUnlinked); the result lists it. After growth the map is only asked
-  // whether an edge has none, one or two triangles, so the triangle numbers it holds are left as
-  // they were.
+  // widened hole's ring or of a scrap (kUnlinked); the result lists it. After growth the map is
+  // only asked whether an edge has none, one or two triangles, so the triangle numbers it holds are
+  // left as they were.
   void compact(std::vector<std::uint8_t> dead) {
     std::size_t kept = 0, kept_loaded = 0;
     for (std::size_t t = 0; t < triangles_.size(); ++t) {

@@ -48,7 +48,8 @@ struct GrowResult {
   std::vector<std::uint32_t> group;
   std::vector<std::uint8_t> flip;
   // Preloaded triangles taken off (sorted places in the context's preload): the ring around a
-  // hole that could only be filled once widened (docs/algorithm.md, "Hole filling").
+  // hole that could only be filled once widened, and scraps whose every point the run judges
+  // (docs/algorithm.md, "Hole filling").
   std::vector<std::uint32_t> removed_preload;
   std::uint64_t seeds = 0;
   // Points where a triangle started a second fan (fronts meeting at a point): the only places a

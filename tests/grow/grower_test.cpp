@@ -1,7 +1,8 @@
 // The grower's gap closing (src/grow/grower.cpp, close_three_edge_gaps) on a hand-made front:
 // three kept triangles around a triangular gap, with a context point in the gap that is every
 // gap edge's Gabriel point but may not join, so the front itself leaves the gap open. And the
-// removal of scraps (remove_scraps): a lone triangle near a flat patch, and one far from it. And
+// removal of scraps (remove_scraps): a lone triangle near a flat patch, and one far from it,
+// grown or loaded before the run. And
 // the cap that closes a piece's only loop with a point left over (cap_single_loops).
 #include "grow/grower.hpp"
 
@@ -105,7 +106,7 @@ TEST(GapClosing, AGapIsNotClosedWhereItWouldFold) {
 // `height` above its middle, out of the front's reach, so that they seed a lone triangle of
 // their own. Returns the grown triangles (input indices); the lone triangle's points are
 // 576-578.
-std::vector<Triangle> grow_patch_with_lone_triangle(float height, int max_hole_rings) {
+std::vector<float> patch_with_lone_points(float height) {
   std::vector<float> xyz;
   std::uint32_t state = 12345;
   const auto jitter = [&state] {
@@ -119,8 +120,18 @@ std::vector<Triangle> grow_patch_with_lone_triangle(float height, int max_hole_r
     }
   }
   xyz.insert(xyz.end(), {11.2f, 11.3f, height, 12.1f, 11.4f, height, 11.6f, 12.2f, height});
-  std::vector<Index> ids(xyz.size() / 3);
-  for (std::size_t k = 0; k < ids.size(); ++k) ids[k] = static_cast<Index>(k);
+  return xyz;
+}
+
+std::vector<Index> identity_ids(std::size_t count) {
+  std::vector<Index> ids(count);
+  for (std::size_t k = 0; k < count; ++k) ids[k] = static_cast<Index>(k);
+  return ids;
+}
+
+std::vector<Triangle> grow_patch_with_lone_triangle(float height, int max_hole_rings) {
+  const std::vector<float> xyz = patch_with_lone_points(height);
+  const std::vector<Index> ids = identity_ids(xyz.size() / 3);
   const g2s::HashGrid grid(xyz, ids);
   g2s::MeshOptions options;
   options.max_hole_rings = max_hole_rings;
@@ -154,6 +165,47 @@ TEST(Scraps, ALoneTriangleNearTheSurfaceGoesAndItsPointsAreLeftOut) {
 
 TEST(Scraps, ALoneTriangleFarFromTheSurfaceStays) {
   EXPECT_TRUE(has_lone_triangle(grow_patch_with_lone_triangle(6.0f, 3)));
+}
+
+// The patch and the lone triangle grown without leaving points out, then loaded before a
+// second run (as a seam loads a tile's triangles; the lone one lost its neighbours in the tile's
+// halo). `judge_corner` false: a corner of the lone triangle is a point the second run does not
+// judge (a seam's context). Returns the loaded triangles the second run removed, as input
+// indices, and how many triangles it added.
+std::pair<std::vector<Triangle>, std::size_t> regrow_loaded_patch(bool judge_corner) {
+  const std::vector<float> xyz = patch_with_lone_points(1.5f);
+  const g2s::HashGrid grid(xyz, identity_ids(xyz.size() / 3));
+  g2s::MeshOptions options;
+  options.max_hole_rings = 0;
+  const g2s::GrowResult first = g2s::grow_mesh(grid, options);
+  std::vector<std::uint8_t> growable(grid.size(), 1);
+  if (!judge_corner) {
+    for (std::uint32_t k = 0; k < grid.size(); ++k) {
+      if (grid.id(k) == 578) growable[k] = 0;
+    }
+  }
+  options.max_hole_rings = 3;
+  const g2s::GrowResult second =
+      g2s::grow_mesh(grid, options, {first.triangles, first.group, growable, {}, 0, {}});
+  std::vector<Triangle> removed;
+  for (std::uint32_t k : second.removed_preload) {
+    const Triangle& t = first.triangles[k];
+    removed.push_back({grid.id(t[0]), grid.id(t[1]), grid.id(t[2])});
+  }
+  return {removed, second.triangles.size()};
+}
+
+TEST(Scraps, ALoadedLoneTriangleNearTheSurfaceGoesWhenTheRunJudgesEveryCorner) {
+  const auto [removed, added] = regrow_loaded_patch(true);
+  ASSERT_EQ(removed.size(), 1u);
+  EXPECT_TRUE(has_lone_triangle(removed));
+  EXPECT_EQ(added, 0u);
+}
+
+TEST(Scraps, ALoadedLoneTriangleWithACornerTheRunDoesNotJudgeStays) {
+  const auto [removed, added] = regrow_loaded_patch(false);
+  EXPECT_TRUE(removed.empty());
+  EXPECT_EQ(added, 0u);
 }
 
 // Capping a piece's only loop (cap_single_loops): the four corners of a regular tetrahedron,
