@@ -52,6 +52,22 @@ def test_mesh_gives_the_cli_mesh(torus_ply, tmp_path):
     assert own_set == cli_set
 
 
+def test_mesh_at_the_defaults_cuts_tiles_as_the_cli_does(tmp_path):
+    """Without tile_points, g2s.mesh plans the tiles as `g2s mesh` does: a cloud of 100k points is
+    cut into at least four tiles (grown in parallel), the same as the CLI's, so the mesh is too."""
+    cloud = tmp_path / "torus100k.ply"
+    code, _, err = run_cli("synth", "torus", "--points", "100000", "-o", cloud)
+    assert code == 0, err
+    code, stdout, err = run_cli("mesh", cloud, "-o", tmp_path / "cli.ply", "--json")
+    assert code == 0, err
+    cli = json.loads(stdout)
+    triangles, summary = g2s.mesh(read_ply_points(cloud))
+    assert cli["tiles"] >= 4
+    assert summary["tiles"] == cli["tiles"]
+    assert summary["triangles"] == cli["triangles"] == len(triangles)
+    assert summary["triangles_stitched"] == cli["triangles_stitched"]
+
+
 def read_ply_mesh(path):
     """(vertices, faces) of the indexed binary PLY g2s writes (float x, y, z; uchar count + uint
     indices)."""
