@@ -69,18 +69,10 @@ std::uint64_t budget_of(std::optional<std::uint64_t> memory) {
 }
 
 // The one call of the library's in-memory mesher: a change of its API is a change here only.
-// Tiles as `g2s mesh` cuts them for the same budget (the planned tile, and at least the plan's
-// minimum number of tiles, so that clouds from about 100k points up grow in parallel), grown in
-// parallel and stitched.
-g2s::PipelineMesh mesh_in_memory(const g2s::PointCloud& cloud, g2s::PipelineOptions options,
+// Tiles as `g2s mesh` cuts them for the same budget, grown in parallel and stitched.
+g2s::PipelineMesh mesh_in_memory(const g2s::PointCloud& cloud, const g2s::PipelineOptions& options,
                                  std::uint64_t budget, std::uint64_t tile_points) {
-  const g2s::MemoryPlan plan = g2s::plan_memory(budget, options.threads);
-  options.tiles_in_flight = plan.tiles_in_flight;
-  g2s::TileStoreOptions tiling;
-  tiling.tile_points = tile_points > 0 ? tile_points : plan.tile_points;
-  if (tile_points == 0) tiling.min_tiles = plan.min_tiles;
-  const g2s::MemoryTiles tiles(cloud, g2s::largest_tile_points(tiling, cloud.size()));
-  return g2s::mesh_tiles(tiles, options);
+  return g2s::mesh_cloud(cloud, options, tile_points, budget);
 }
 
 // An (N, 3) float32/float64 array as the library's cloud: 3 doubles a point. The library's

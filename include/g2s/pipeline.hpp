@@ -51,11 +51,12 @@ PipelineSummary mesh_tiles(const TileSource& source, const PipelineOptions& opti
 PipelineMesh mesh_tiles(const TileSource& source, const PipelineOptions& options);
 
 // A whole cloud in memory, meshed as `g2s mesh` meshes it: cut into MemoryTiles of at most
-// tile_points points (0: the size plan_memory chooses for the default budget and
-// options.threads, as the CLI does), then mesh_tiles. Triangles index into cloud.xyz. Throws
-// Error(bad_input) for more than 2^32-1 points.
+// tile_points points (0: the size plan_memory chooses for budget_bytes and options.threads, and
+// at least the plan's minimum number of tiles, as the CLI does), then mesh_tiles, with the
+// plan's tiles in flight unless options set them. budget_bytes 0: default_memory_budget().
+// Triangles index into cloud.xyz. Throws Error(bad_input) for more than 2^32-1 points.
 PipelineMesh mesh_cloud(const PointCloud& cloud, const PipelineOptions& options = {},
-                        std::uint64_t tile_points = 0);
+                        std::uint64_t tile_points = 0, std::uint64_t budget_bytes = 0);
 
 // How `g2s mesh --memory` spends a budget of bytes (peak resident memory, as /usr/bin/time -v
 // reports it): the largest tile, the tiles grown and waiting at once, and the points the tile

@@ -8,16 +8,19 @@
 namespace g2s {
 
 PipelineMesh mesh_cloud(const PointCloud& cloud, const PipelineOptions& options,
-                        std::uint64_t tile_points) {
+                        std::uint64_t tile_points, std::uint64_t budget_bytes) {
+  const MemoryPlan plan =
+      plan_memory(budget_bytes > 0 ? budget_bytes : default_memory_budget(), options.threads);
   if (tile_points == 0) {
-    const MemoryPlan plan = plan_memory(default_memory_budget(), options.threads);
     TileStoreOptions tiling;
     tiling.tile_points = plan.tile_points;
     tiling.min_tiles = plan.min_tiles;
     tile_points = largest_tile_points(tiling, cloud.size());
   }
+  PipelineOptions planned = options;
+  if (planned.tiles_in_flight == 0) planned.tiles_in_flight = plan.tiles_in_flight;
   const MemoryTiles tiles(cloud, tile_points);
-  return mesh_tiles(tiles, options);
+  return mesh_tiles(tiles, planned);
 }
 
 }  // namespace g2s
