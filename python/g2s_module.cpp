@@ -1,7 +1,8 @@
 // The Python module g2s (pybind11, numpy): the library's three ways of use from Python.
 //   g2s.mesh(points, ...)          -> (triangles, summary): an (N, 3) array meshed in memory,
 //                                     tiled and parallel like `g2s mesh`, the GIL released
-//   g2s.mesh_file(input, output, ...) -> summary: the out-of-core pipeline, file to file
+//   g2s.mesh_file(input, output, ...) -> summary: the out-of-core pipeline, file to file, the
+//                                     defects counted as the mesh streams out
 //   g2s.stats(points, triangles)   -> dict: g2s stats' counts
 // Options are the CLI's (`--max-fold` is max_fold=...). g2s::Error becomes g2s.Error (or its
 // subclass for the exit code) with the CLI's message, without its "g2s: error: " prefix.
@@ -27,6 +28,7 @@
 #include "g2s/io.hpp"
 #include "g2s/pipeline.hpp"
 #include "g2s/stats.hpp"
+#include "g2s/stream_stats.hpp"
 #include "g2s/surface_check.hpp"
 #include "g2s/tile_store.hpp"
 
@@ -219,11 +221,14 @@ py::dict mesh_file(const std::filesystem::path& input, const std::filesystem::pa
   const g2s::TileStore store(store_path);
   const g2s::ReadReport& read = store.input_report();
   options.tiles_in_flight = tiled.plan.tiles_in_flight;
-  g2s::PipelineSummary summary;
-  {
-    g2s::MeshStreamWriter writer(output, g2s::mesh_format_for(output, ascii));
-    summary = g2s::mesh_tiles(store, options, writer);
-  }
+  // The defects are counted as the mesh streams out, as `g2s mesh` counts them; only where that
+  // count could not be exact is the file read back, if that fits in the budget.
+  const g2s::MeshFormat format = g2s::mesh_format_for(output, ascii);
+  const bool stl = format != g2s::MeshFormat::ply_binary;
+  g2s::MeshStreamWriter writer(output, format);
+  g2s::StreamStats counter(writer, stl, !stl);
+  const g2s::PipelineSummary summary =
+      g2s::mesh_tiles(store, options, no_stats ? static_cast<g2s::MeshSink&>(writer) : counter);
   if (summary.triangles == 0) {
     g2s::PointCloud cloud;
     for (std::size_t t = 0; t < store.tiles().size(); ++t) {
@@ -233,7 +238,11 @@ py::dict mesh_file(const std::filesystem::path& input, const std::filesystem::pa
     throw_no_surface(input.string(), cloud, summary.report.points, read.non_finite);
   }
   std::string stats;
-  if (!no_stats && summary.triangles * kStatsBytesPerTriangle <= budget) {
+  const bool in_stride = !no_stats && g2s::counted_as_written(counter, stl, writer.float_rounding(),
+                                                              summary.report.spacing);
+  if (in_stride) {
+    stats = g2s::stats_to_json(counter.stats());
+  } else if (!no_stats && summary.triangles * kStatsBytesPerTriangle <= budget) {
     stats = g2s::stats_to_json(g2s::compute_stats(g2s::read_mesh(output)));
   }
   const double seconds =
@@ -246,6 +255,7 @@ py::dict mesh_file(const std::filesystem::path& input, const std::filesystem::pa
   d["non_finite"] = read.non_finite;
   d["seconds"] = seconds;
   if (!stats.empty()) d["stats"] = parse_json(stats);
+  d["stats_in_stride"] = in_stride;
   return d;
 }
 

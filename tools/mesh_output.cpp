@@ -255,8 +255,8 @@ void write_and_report(const TileSource& source,
   bool measure = false;
   // Far from the origin, STL's floats may merge vertices the stream saw apart (the warning
   // above): the file is then measured as read back.
-  const bool stream_exact = counter.complete() && (format == MeshFormat::ply_binary ||
-                                                   writer.float_rounding() <= 0.01 * r.spacing);
+  const bool stream_exact =
+      counted_as_written(counter, rounded, writer.float_rounding(), r.spacing);
   if (!args.no_stats && stream_exact) {
     stats = counter.stats();
     measure = true;

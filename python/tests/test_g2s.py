@@ -182,6 +182,25 @@ def test_mesh_file_is_the_cli_mesh(torus_ply, tmp_path):
     assert summary["format"] == "ply-binary-le"
 
 
+def test_mesh_file_counts_the_defects_as_the_mesh_streams_out(tmp_path):
+    """As `g2s mesh`: counted in stride, not read back, and the counts of `g2s stats` on the
+    file, for PLY and for STL (whose float rounding the count judges)."""
+    cloud = tmp_path / "noisy.ply"
+    code, _, err = run_cli("synth", "torus", "--points", "30000", "--noise", "1", "-o", cloud)
+    assert code == 0, err
+    for name in ("m.ply", "m.stl"):
+        out = tmp_path / name
+        summary = g2s.mesh_file(cloud, out, tile_points=8000)
+        assert summary["stats_in_stride"], name
+        code, stdout, err = run_cli("stats", out, "--json")
+        assert code == 0, err
+        measured = json.loads(stdout)
+        assert summary["stats"]["boundary_edges"] > 0, name  # a mesh with defects to count
+        assert summary["stats"] == {k: measured[k] for k in summary["stats"]}, name
+    summary = g2s.mesh_file(cloud, tmp_path / "n.ply", no_stats=True)
+    assert "stats" not in summary and not summary["stats_in_stride"]
+
+
 def test_mesh_file_cuts_tiles_as_the_cli_does(tmp_path):
     """Without tile_points, mesh_file cuts the cloud as `g2s mesh` does for the same budget: at
     least four tiles, and under a tight budget the band of open seams predicted and the cloud cut

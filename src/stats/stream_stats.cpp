@@ -927,6 +927,10 @@ const MeshStats& StreamStats::stats() const {
 bool StreamStats::complete() const {
   return impl_->complete;
 }
+bool counted_as_written(const StreamStats& counter, bool stl, double float_rounding,
+                        double spacing) {
+  return counter.complete() && (!stl || float_rounding <= 0.01 * spacing);
+}
 std::uint64_t StreamStats::peak_bytes() const {
   return std::max(impl_->peak, impl_->bytes());
 }
