@@ -152,7 +152,7 @@ py::dict report_dict(const g2s::PipelineSummary& s) {
 
 std::pair<py::array, py::dict> mesh(const py::array& points, std::optional<int> threads,
                                     std::optional<std::uint64_t> memory, std::uint64_t tile_points,
-                                    const MesherArgs& mesher) {
+                                    bool no_stats, const MesherArgs& mesher) {
   const auto start = std::chrono::steady_clock::now();
   g2s::PointCloud cloud = cloud_from(points);
   const std::uint64_t rows = cloud.size();
@@ -163,7 +163,7 @@ std::pair<py::array, py::dict> mesh(const py::array& points, std::optional<int> 
   {
     py::gil_scoped_release released;
     *result = mesh_in_memory(cloud, options, budget_of(memory), tile_points);
-    if (!result->triangles.empty()) {
+    if (!no_stats && !result->triangles.empty()) {
       stats = g2s::compute_stats({cloud.xyz, result->triangles}, &cloud);
     }
     for (g2s::Triangle& t : result->triangles) {
@@ -177,7 +177,7 @@ std::pair<py::array, py::dict> mesh(const py::array& points, std::optional<int> 
   summary["non_finite"] = rows - cloud.size();
   summary["seconds"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  summary["stats"] = parse_json(g2s::stats_to_json(stats));
+  if (!no_stats) summary["stats"] = parse_json(g2s::stats_to_json(stats));
   // The triangles leave as a numpy view of the library's vector, owned by a capsule: no copy.
   auto* triangles = new std::vector<g2s::Triangle>(std::move(result->triangles));
   const py::capsule owner(triangles,
@@ -331,16 +331,16 @@ PYBIND11_MODULE(_g2s, m) {
   m.def(
       "mesh",
       [mesher_args](const py::array& points, std::optional<int> threads,
-                    std::optional<std::uint64_t> memory, std::uint64_t tile_points,
+                    std::optional<std::uint64_t> memory, std::uint64_t tile_points, bool no_stats,
                     std::optional<std::vector<double>> radius_steps, int flatness_levels,
                     double max_fold, double max_radius, bool keep_gaps, int max_hole_edges,
                     int max_hole_rings, bool no_orient) {
-        return mesh(points, threads, memory, tile_points,
+        return mesh(points, threads, memory, tile_points, no_stats,
                     mesher_args(std::move(radius_steps), flatness_levels, max_fold, max_radius,
                                 keep_gaps, max_hole_edges, max_hole_rings, no_orient));
       },
       py::arg("points"), py::kw_only(), py::arg("threads") = py::none(),
-      py::arg("memory") = py::none(), py::arg("tile_points") = 0,
+      py::arg("memory") = py::none(), py::arg("tile_points") = 0, py::arg("no_stats") = false,
       py::arg("radius_steps") = py::none(), py::arg("flatness_levels") = 4,
       py::arg("max_fold") = 135.0, py::arg("max_radius") = 6.0, py::arg("keep_gaps") = false,
       py::arg("max_hole_edges") = 30, py::arg("max_hole_rings") = 3, py::arg("no_orient") = false);

@@ -44,18 +44,19 @@ def _mesher(radius_steps, flatness_levels, max_fold, max_radius, max_hole_edges,
             raise UsageError(f"{name}: {value} is not in [{lo}, {hi}]")
 
 
-def mesh(points, *, threads=None, memory=None, tile_points=0, radius_steps=None,
+def mesh(points, *, threads=None, memory=None, tile_points=0, no_stats=False, radius_steps=None,
          flatness_levels=4, max_fold=135.0, max_radius=6.0, keep_gaps=False, max_hole_edges=30,
          max_hole_rings=3, no_orient=False):
     """Meshes an (N, 3) float32 or float64 array in memory, tiled and in parallel as `g2s mesh`
     (`memory` sets the tile size, default half the RAM; `threads` default all cores). The GIL is
     released while meshing. Returns (triangles, summary): an (M, 3) uint32 array of indices into
     `points`, and a dict of counts (points, triangles, tiles, spacing, seconds, ...) with the
-    mesh's defects under "stats". Points with NaN or Inf coordinates are never used. Raises
-    NoSurfaceError when the points form no surface, with the CLI's reason."""
+    mesh's defects under "stats" (`g2s stats --points`' counts, crossings and coverage included;
+    left out with no_stats, which saves their time). Points with NaN or Inf coordinates are never
+    used. Raises NoSurfaceError when the points form no surface, with the CLI's reason."""
     _mesher(radius_steps, flatness_levels, max_fold, max_radius, max_hole_edges, max_hole_rings)
     return _g2s.mesh(points, threads=threads, memory=_bytes(memory), tile_points=tile_points,
-                     radius_steps=radius_steps, flatness_levels=flatness_levels,
+                     no_stats=no_stats, radius_steps=radius_steps, flatness_levels=flatness_levels,
                      max_fold=max_fold, max_radius=max_radius, keep_gaps=keep_gaps,
                      max_hole_edges=max_hole_edges, max_hole_rings=max_hole_rings,
                      no_orient=no_orient)
@@ -68,8 +69,10 @@ def mesh_file(input, output, *, threads=None, memory=None, tile_points=0, keep_s
     """`g2s mesh INPUT -o OUTPUT` in this process: the cloud (PLY, LAS, XYZ) is cut into a tile
     store beside the output (or at keep_store), grown and stitched within `memory`, and the
     mesh streamed to OUTPUT (.ply, or .stl; ascii=True for ASCII STL). Returns the summary dict
-    of `g2s mesh --json`; "stats" is left out when no_stats or when reading the mesh back would
-    not fit in `memory`."""
+    of `g2s mesh --json`; "stats" holds the defects counted as the mesh streamed out
+    ("stats_in_stride" true; the crossing pairs are left to `g2s stats`), or, where that count
+    could not be exact, as read back; it is left out when no_stats or when reading the mesh back
+    would not fit in `memory`."""
     _mesher(radius_steps, flatness_levels, max_fold, max_radius, max_hole_edges, max_hole_rings)
     return _g2s.mesh_file(str(input), str(output), threads=threads, memory=_bytes(memory),
                           tile_points=tile_points,

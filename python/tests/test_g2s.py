@@ -52,6 +52,17 @@ def test_mesh_gives_the_cli_mesh(torus_ply, tmp_path):
     assert own_set == cli_set
 
 
+def test_mesh_without_stats_gives_the_same_triangles(torus_ply):
+    """no_stats=True skips measuring the mesh (the crossing search and the coverage): the same
+    triangles, no "stats" in the summary."""
+    points = read_ply_points(torus_ply)
+    measured, summary = g2s.mesh(points, tile_points=5000)
+    plain, bare = g2s.mesh(points, tile_points=5000, no_stats=True)
+    assert "stats" in summary and "stats" not in bare
+    assert np.array_equal(measured, plain)
+    assert bare["triangles"] == summary["triangles"]
+
+
 def test_mesh_at_the_defaults_cuts_tiles_as_the_cli_does(tmp_path):
     """Without tile_points, g2s.mesh plans the tiles as `g2s mesh` does: a cloud of 100k points is
     cut into at least four tiles (grown in parallel), the same as the CLI's, so the mesh is too."""
