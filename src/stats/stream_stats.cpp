@@ -927,12 +927,13 @@ const MeshStats& StreamStats::stats() const {
 bool StreamStats::complete() const {
   return impl_->complete;
 }
+std::uint64_t StreamStats::peak_bytes() const {
+  return std::max(impl_->peak, impl_->bytes());
+}
+
 bool counted_as_written(const StreamStats& counter, bool stl, double float_rounding,
                         double spacing) {
   return counter.complete() && (!stl || float_rounding <= 0.01 * spacing);
-}
-std::uint64_t StreamStats::peak_bytes() const {
-  return std::max(impl_->peak, impl_->bytes());
 }
 
 }  // namespace g2s
