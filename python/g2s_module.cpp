@@ -36,10 +36,6 @@ namespace py = pybind11;
 
 namespace {
 
-// Reading a mesh back to measure it takes about this many bytes a triangle (as in `g2s mesh`,
-// whose summary measures the mesh only when that fits in --memory).
-constexpr std::uint64_t kStatsBytesPerTriangle = 160;
-
 // The mesher's options as keyword arguments, named as the CLI's flags.
 struct MesherArgs {
   std::optional<std::vector<double>> radius_steps;
@@ -68,13 +64,6 @@ g2s::PipelineOptions pipeline_options(const MesherArgs& m, int threads) {
 
 std::uint64_t budget_of(std::optional<std::uint64_t> memory) {
   return memory ? *memory : g2s::default_memory_budget();
-}
-
-// The one call of the library's in-memory mesher: a change of its API is a change here only.
-// Tiles as `g2s mesh` cuts them for the same budget, grown in parallel and stitched.
-g2s::PipelineMesh mesh_in_memory(const g2s::PointCloud& cloud, const g2s::PipelineOptions& options,
-                                 std::uint64_t budget, std::uint64_t tile_points) {
-  return g2s::mesh_cloud(cloud, options, tile_points, budget);
 }
 
 // An (N, 3) float32/float64 array as the library's cloud: 3 doubles a point. The library's
@@ -162,7 +151,8 @@ std::pair<py::array, py::dict> mesh(const py::array& points, std::optional<int> 
   g2s::MeshStats stats;
   {
     py::gil_scoped_release released;
-    *result = mesh_in_memory(cloud, options, budget_of(memory), tile_points);
+    // Tiles as `g2s mesh` cuts them for the same budget, grown in parallel and stitched.
+    *result = g2s::mesh_cloud(cloud, options, tile_points, budget_of(memory));
     if (!no_stats && !result->triangles.empty()) {
       stats = g2s::compute_stats({cloud.xyz, result->triangles}, &cloud);
     }
@@ -237,14 +227,10 @@ py::dict mesh_file(const std::filesystem::path& input, const std::filesystem::pa
     }
     throw_no_surface(input.string(), cloud, summary.report.points, read.non_finite);
   }
-  std::string stats;
-  const bool in_stride = !no_stats && g2s::counted_as_written(counter, stl, writer.float_rounding(),
-                                                              summary.report.spacing);
-  if (in_stride) {
-    stats = g2s::stats_to_json(counter.stats());
-  } else if (!no_stats && summary.triangles * kStatsBytesPerTriangle <= budget) {
-    stats = g2s::stats_to_json(g2s::compute_stats(g2s::read_mesh(output)));
-  }
+  const g2s::WrittenMeshStats written =
+      no_stats ? g2s::WrittenMeshStats{}
+               : g2s::measure_written_mesh(counter, output, stl, writer.float_rounding(),
+                                           summary.report.spacing, summary.triangles, budget);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   py::gil_scoped_acquire acquired;
@@ -254,8 +240,8 @@ py::dict mesh_file(const std::filesystem::path& input, const std::filesystem::pa
   d["format"] = read.format;
   d["non_finite"] = read.non_finite;
   d["seconds"] = seconds;
-  if (!stats.empty()) d["stats"] = parse_json(stats);
-  d["stats_in_stride"] = in_stride;
+  if (written.stats) d["stats"] = parse_json(g2s::stats_to_json(*written.stats));
+  d["stats_in_stride"] = written.in_stride;
   return d;
 }
 

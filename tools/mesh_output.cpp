@@ -29,11 +29,6 @@
 namespace g2s::cli {
 namespace {
 
-// Reading a mesh back and measuring it takes about this much per triangle (STL welding, the
-// stats' edge map): `g2s stats` on the 20M-triangle torus STL peaked at 1.70 GB (85 bytes a
-// triangle); twice that leaves room for meshes with more vertices per triangle.
-constexpr std::uint64_t kStatsBytesPerTriangle = 160;
-
 // Threads from which the sink gets a thread of its own (SinkBehind). Growth takes 7 to 16 times
 // the serial stitch stage's CPU on the runs measured (the 20M torus, alpe, raw-bunny), so the
 // stitcher starts to bound a run from about 8 threads; below, the thread would cost its heap
@@ -251,20 +246,14 @@ void write_and_report(const TileSource& source,
   // fits in the budget.
   const auto summary_start = std::chrono::steady_clock::now();
   const double summary_cpu = cpu_seconds();
-  MeshStats stats;
-  bool measure = false;
   // Far from the origin, STL's floats may merge vertices the stream saw apart (the warning
   // above): the file is then measured as read back.
-  const bool stream_exact =
-      counted_as_written(counter, rounded, writer.float_rounding(), r.spacing);
-  if (!args.no_stats && stream_exact) {
-    stats = counter.stats();
-    measure = true;
-  } else if (!args.no_stats &&
-             (args.memory == 0 || triangles * kStatsBytesPerTriangle <= args.memory)) {
-    stats = compute_stats(read_mesh(args.output));
-    measure = true;
-  }
+  const WrittenMeshStats written =
+      args.no_stats ? WrittenMeshStats{}
+                    : measure_written_mesh(counter, args.output, rounded, writer.float_rounding(),
+                                           r.spacing, triangles, args.memory);
+  const bool measure = written.stats.has_value();
+  const MeshStats stats = written.stats.value_or(MeshStats{});
   const StageTime measured{seconds_since(summary_start), cpu_seconds() - summary_cpu};
   const double seconds = seconds_since(facts.start);
   const double ktps = static_cast<double>(triangles) / seconds / 1000.0;
@@ -314,7 +303,7 @@ void write_and_report(const TileSource& source,
             .raw("summary", JsonObject()
                                 .fixed("wall", measured.wall, 3)
                                 .fixed("cpu", measured.cpu, 3)
-                                .number("in_stride", measure && stream_exact)
+                                .number("in_stride", written.in_stride)
                                 .fixed("counter_peak_mb", counter_mb, 1)
                                 .str())
             .str());
@@ -335,8 +324,8 @@ void write_and_report(const TileSource& source,
                stats.non_manifold_edges, stats.non_manifold_vertices, stats.orientation_conflicts,
                stats.boundary_edges, stats.holes, stats.duplicate_triangles,
                stats.degenerate_triangles, stats.components,
-               stream_exact ? std::string("not counted here (g2s stats counts them)")
-                            : std::to_string(stats.crossing_pairs));
+               written.in_stride ? std::string("not counted here (g2s stats counts them)")
+                                 : std::to_string(stats.crossing_pairs));
   } else if (!args.no_stats) {
     fmt::print(stderr,
                "; defects not measured: reading the mesh back would exceed --memory "

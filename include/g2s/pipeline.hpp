@@ -11,9 +11,12 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
+#include "g2s/stats.hpp"
+#include "g2s/stream_stats.hpp"
 #include "g2s/tile_stages.hpp"
 #include "g2s/tile_store.hpp"
 
@@ -41,6 +44,26 @@ void write_tile_growth(const std::filesystem::path& file, std::uint32_t tile,
                        std::uint64_t fingerprint, std::uint64_t options, const TileGrowth& growth);
 TileGrowth read_tile_growth(const std::filesystem::path& file, std::uint32_t tile,
                             std::uint64_t fingerprint, std::uint64_t options);
+
+// The defects of a mesh file written by streaming a run into `counter`, a StreamStats in front
+// of the file's MeshStreamWriter, as `g2s mesh` reports them. The count, where it is the file's
+// (in_stride): every triangle came before its vertices were done, and the file keeps the
+// positions the count judged: binary PLY exactly (`stl` false); STL's 32-bit floats merge no
+// vertices the stream saw apart while rounding (`float_rounding`,
+// MeshStreamWriter::float_rounding()) moves them by at most a hundredth of the sampling
+// `spacing`. Else the file read back and measured (compute_stats, crossing pairs included), if
+// its `triangles` fit in `memory_bytes` (0: no limit) at kStatsBytesPerTriangle; else none.
+struct WrittenMeshStats {
+  std::optional<MeshStats> stats;
+  bool in_stride = false;
+};
+WrittenMeshStats measure_written_mesh(const StreamStats& counter, const std::filesystem::path& file,
+                                      bool stl, double float_rounding, double spacing,
+                                      std::uint64_t triangles, std::uint64_t memory_bytes);
+// What reading a mesh back and measuring it takes per triangle (STL welding, the stats' edge
+// map): `g2s stats` on the 20M-triangle torus STL peaked at 1.70 GB (85 bytes a triangle); twice
+// that leaves room for meshes with more vertices per triangle.
+inline constexpr std::uint64_t kStatsBytesPerTriangle = 160;
 
 // All stages in one process: grow_tile over every tile as TBB tasks (at most
 // options.tiles_in_flight grown and not yet stitched), stitched in order into `sink`.

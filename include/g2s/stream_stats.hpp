@@ -56,13 +56,4 @@ class StreamStats final : public MeshSink {
   std::unique_ptr<Impl> impl_;
 };
 
-// Whether the counts of `counter`, streamed into a mesh file, are those of the file as written
-// (compute_stats on it, but the crossing pairs): no triangle came after its vertices were done
-// (complete()), and the file keeps the positions the count judged. Binary PLY keeps them exactly
-// (`stl` false); STL keeps 32-bit floats, which may merge vertices the stream saw apart once
-// rounding moves them by more than a hundredth of the sampling `spacing` (`float_rounding`,
-// MeshStreamWriter::float_rounding()). Where this is false, measure the file as read back.
-bool counted_as_written(const StreamStats& counter, bool stl, double float_rounding,
-                        double spacing);
-
 }  // namespace g2s

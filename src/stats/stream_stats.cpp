@@ -931,9 +931,4 @@ std::uint64_t StreamStats::peak_bytes() const {
   return std::max(impl_->peak, impl_->bytes());
 }
 
-bool counted_as_written(const StreamStats& counter, bool stl, double float_rounding,
-                        double spacing) {
-  return counter.complete() && (!stl || float_rounding <= 0.01 * spacing);
-}
-
 }  // namespace g2s
