@@ -137,7 +137,7 @@ class Grower {
   bool used(Index i) const { return state_[i] & kUsed; }
   bool interior(Index i) const { return state_[i] == kUsed; }
   bool growable(Index i) const { return growable_.empty() || growable_[i]; }
-  bool fillable(Index i) const { return growable(i) && (fillable_.empty() || fillable_[i]); }
+  bool fillable(Index i) const { return fillable_.empty() ? growable(i) : fillable_[i] != 0; }
 
   // Enters the triangles kept before this run, each its own orientation group (joined where they
   // share an edge, and as `links` say); their open edges at growable points become the front.
@@ -1202,7 +1202,7 @@ class Grower {
     if (!growable_.empty()) {
       bool covers_context = false;
       grid_.for_each_in_ball(ball.centre, std::sqrt(ball.radius2), [&](std::uint32_t j, double) {
-        covers_context = covers_context || !growable(j);
+        covers_context = covers_context || (!growable(j) && !fillable(j));
       });
       if (covers_context) return false;
     }

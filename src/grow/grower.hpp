@@ -28,8 +28,9 @@ struct GrowContext {
   std::span<const Link> preload_links;
   // How many more points, in Gabriel order, an edge tries when its Gabriel point cannot join.
   int retries = 0;
-  // Per grid point, non-zero: may be a corner of a triangle that fills a hole (a tile's points
-  // out of every seam's reach: holes nearer a seam are the seam's); empty: every growable one.
+  // Per grid point, non-zero: may be a corner of a triangle that fills a hole, whether growable
+  // or not (a tile's own points; at a seam, the points whose whole stars it loads: the band's and
+  // the live ones of its context); empty: every growable one.
   std::span<const std::uint8_t> fillable;
   // The whole cloud's spacing (a tile's or a seam's grid sees only part of it), or 0: the
   // search radius is capped at max_radius times the larger of it and the lower confidence bound

@@ -24,8 +24,8 @@ namespace g2s {
 
 struct LiveMesh {
   static constexpr std::uint8_t kFinished = 1;
-  static constexpr std::uint8_t kSuspect = 2;  // may have more than one fan
-  static constexpr std::uint8_t kInBand = 4;   // scratch of the seam being stitched
+  static constexpr std::uint8_t kSuspect = 2;     // may have more than one fan
+  static constexpr std::uint8_t kStarLoaded = 4;  // scratch of the seam being stitched
   static constexpr std::uint8_t kReleased = 8;
   static constexpr std::uint8_t kUnlisted = 16;   // not in slot_of: no seam will look it up
   static constexpr std::uint8_t kInContext = 32;  // scratch of the seam being stitched

@@ -5,8 +5,10 @@
 // those seams, with every live triangle that touches those points loaded into the Point-Edge Map:
 // their open edges are the front, and no new triangle can give an edge a third triangle or a vertex
 // a crossing fan the clean-up cannot see. Points farther out are loaded as context, so the Gabriel
-// test sees the whole neighbourhood, but are not used. A new triangle that crosses a live
-// triangle touching only context points (not loaded, so the grower could not see it) is left out.
+// test sees the whole neighbourhood; they grow nothing, but the live triangles at those of this
+// tile and the earlier ones are loaded too (their stars are then whole), so that holes reaching
+// past the band are filled over them. A new triangle that crosses a live triangle touching only
+// the rest of the context (not loaded, so the grower could not see it) is left out.
 //
 // Memory: only the live mesh is kept (stitch/live_mesh.hpp). After each tile the points no later
 // seam can reach are finished and the triangles around them released to the sink
@@ -69,41 +71,51 @@ class SeamStitcher {
     ids_.clear();
     local_.clear();
     growable_.clear();
+    fillable_.clear();
     local_of_.clear();
     // Positions in a float frame at the tile's centre.
     const LocalFrame frame(box.lo, box.hi);
-    // Returns the point's place in ids_.
-    auto take = [&](Index id, bool in_band, const double* p) {
+    // Returns the point's place in ids_. `seam` is the point's distance from the seam, or more
+    // than the context for a point of a later tile.
+    auto take = [&](Index id, double seam, const double* p) {
       const auto next = static_cast<std::uint32_t>(ids_.size());
       const std::uint32_t at = local_of_.insert(id, next);
       if (at != next) return at;
-      // A band point is live (within the tile's reach, so not finished); a context point may be.
-      // Either is flagged for the preload.
+      // A point of the context that is live and not finished has its whole star loaded (every
+      // live triangle at it, below), so holes may be filled over it; a band point is such a
+      // point (within the tile's reach) and may also grow. A finished one, or one of a later
+      // tile, is context only.
       const std::uint32_t s = live.slot(id);
-      if (s != IdMap::kMissing) live.flags[s] |= in_band ? LiveMesh::kInBand : LiveMesh::kInContext;
+      const bool whole = seam <= reach.context && s != IdMap::kMissing &&
+                         (live.flags[s] & LiveMesh::kFinished) == 0;
+      if (s != IdMap::kMissing)
+        live.flags[s] |= whole ? LiveMesh::kStarLoaded : LiveMesh::kInContext;
       ids_.push_back(id);
-      growable_.push_back(in_band && s != IdMap::kMissing);
+      growable_.push_back(whole && seam <= band);
+      fillable_.push_back(whole);
       frame.append(p, local_);
       return at;
     };
+    const double later = reach.context + 1;  // a later tile's points are context only
     {
       const TilePoints own = source_.load_border(tile, reach.context);
       for (std::size_t k = 0; k < own.size(); ++k) {
-        double d = reach.context + 1;
+        double d = later;
         for (std::size_t j : earlier) d = std::min(d, box_distance(tiles[j].box, &own.xyz[3 * k]));
-        if (d <= reach.context) take(own.ids[k], d <= band, &own.xyz[3 * k]);
+        if (d <= reach.context) take(own.ids[k], d, &own.xyz[3 * k]);
       }
     }
     for (std::size_t j : near) {
       const TilePoints border = source_.load_border(j, reach.context);
       for (std::size_t k = 0; k < border.size(); ++k) {
         const double d = box_distance(box, &border.xyz[3 * k]);
-        if (d <= reach.context) take(border.ids[k], j < tile && d <= band, &border.xyz[3 * k]);
+        if (d <= reach.context) take(border.ids[k], j < tile ? d : later, &border.xyz[3 * k]);
       }
     }
-    // Every live triangle touching the band, presented facing as its group currently does, so
-    // the grower starts from what earlier seams already decided; in the order they were made.
-    // Those touching only the context are kept aside for the crossing check (crossing_context).
+    // Every live triangle touching a point whose star is loaded, presented facing as its group
+    // currently does, so the grower starts from what earlier seams already decided; in the order
+    // they were made. Those touching only the rest of the context are kept aside for the crossing
+    // check (crossing_context).
     preload_.clear();
     preload_group_.clear();
     preload_live_.clear();
@@ -111,7 +123,7 @@ class SeamStitcher {
     for (std::size_t t = 0; t < live.triangles.size(); ++t) {
       const Triangle& tri = live.triangles[t];
       const std::uint8_t touches = live.flags[tri[0]] | live.flags[tri[1]] | live.flags[tri[2]];
-      if (!(touches & LiveMesh::kInBand)) {
+      if (!(touches & LiveMesh::kStarLoaded)) {
         if (touches & LiveMesh::kInContext) {
           for (const Index s : tri)
             context_corners_.push_back(frame.point(&live.xyz[3 * std::size_t{s}]));
@@ -122,8 +134,7 @@ class SeamStitcher {
       Triangle corners{};  // places in ids_ for now
       for (int k = 0; k < 3; ++k) {
         const Index s = tri[k];
-        corners[k] = take(live.id[s], (live.flags[s] & LiveMesh::kInBand) != 0,
-                          &live.xyz[3 * std::size_t{s}]);
+        corners[k] = take(live.id[s], later, &live.xyz[3 * std::size_t{s}]);
       }
       if (parity) std::swap(corners[1], corners[2]);
       preload_.push_back(corners);
@@ -132,7 +143,7 @@ class SeamStitcher {
     }
     for (const Index id : ids_) {
       const std::uint32_t s = live.slot(id);
-      if (s != IdMap::kMissing) live.flags[s] &= ~(LiveMesh::kInBand | LiveMesh::kInContext);
+      if (s != IdMap::kMissing) live.flags[s] &= ~(LiveMesh::kStarLoaded | LiveMesh::kInContext);
     }
 
     // Kept corners stay in the grid in a cloud of twins: a seam's float frame may judge a pair at
@@ -157,14 +168,18 @@ class SeamStitcher {
         }
       }
     }
-    std::vector<std::uint8_t> growable(grid.size());
-    for (std::uint32_t k = 0; k < grid.size(); ++k) growable[k] = growable_[grid.source(k)];
+    std::vector<std::uint8_t> growable(grid.size()), fillable(grid.size());
+    for (std::uint32_t k = 0; k < grid.size(); ++k) {
+      growable[k] = growable_[grid.source(k)];
+      fillable[k] = fillable_[grid.source(k)];
+    }
 
     vote_orientation(grid, growable);
 
     MeshOptions mesh_options = options_.mesh;
     mesh_options.progress = {};
-    GrowContext context{preload_, preload_group_, growable, links_, options_.stitch_retries, {}};
+    GrowContext context{preload_, preload_group_,          growable,
+                        links_,   options_.stitch_retries, fillable};
     context.cloud_spacing = source_.cloud_spacing();
     GrowResult grown = grow_mesh(grid, mesh_options, context);
     const std::vector<std::uint8_t> crossing = crossing_context(grid, grown.triangles);
@@ -336,7 +351,7 @@ class SeamStitcher {
   IdMap local_of_;  // global id -> index in ids_, for the points of the current seam
   std::vector<Index> ids_;
   std::vector<float> local_;
-  std::vector<std::uint8_t> growable_;
+  std::vector<std::uint8_t> growable_, fillable_;
   std::vector<std::uint32_t> grid_of_;  // per point of ids_: its index in the seam grid
   std::vector<Triangle> preload_;
   std::vector<std::uint32_t> preload_group_;

@@ -83,6 +83,62 @@ TEST(GapClosing, AThreeEdgeGapIsClosedFacingLikeItsNeighbours) {
   EXPECT_TRUE(same_cycle(t, 0, 1, 2));
 }
 
+// A flat 5 x 5 grid of points, every cell triangulated but cell (1, 1), loaded before the run as
+// a seam loads the live triangles at the points whose stars it sees whole; no point may grow.
+// `fillable` per input point (empty: none but the growable ones). Returns the triangles the run
+// added, as input indices.
+std::vector<Triangle> fill_loaded_square_hole(const std::vector<std::uint8_t>& fillable) {
+  std::vector<float> xyz;
+  std::vector<Index> ids;
+  for (int i = 0; i < 5; ++i) {
+    for (int j = 0; j < 5; ++j) {
+      xyz.insert(xyz.end(), {static_cast<float>(i), static_cast<float>(j), 0.0f});
+      ids.push_back(static_cast<Index>(5 * i + j));
+    }
+  }
+  const g2s::HashGrid grid(xyz, ids);
+  std::vector<Index> at(25);
+  for (std::uint32_t k = 0; k < grid.size(); ++k) at[grid.id(k)] = k;
+  std::vector<Triangle> preload;
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 4; ++j) {
+      if (i == 1 && j == 1) continue;
+      const Index a = at[5 * i + j], b = at[5 * (i + 1) + j], c = at[5 * (i + 1) + j + 1],
+                  d = at[5 * i + j + 1];
+      preload.push_back({a, b, c});
+      preload.push_back({a, c, d});
+    }
+  }
+  const std::vector<std::uint32_t> labels(preload.size(), 0);
+  const std::vector<std::uint8_t> growable(grid.size(), 0);
+  std::vector<std::uint8_t> fill_at;
+  if (!fillable.empty()) {
+    fill_at.resize(grid.size());
+    for (std::uint32_t k = 0; k < grid.size(); ++k) fill_at[k] = fillable[grid.id(k)];
+  }
+  const g2s::GrowResult r =
+      g2s::grow_mesh(grid, g2s::MeshOptions{}, {preload, labels, growable, {}, 0, fill_at});
+  std::vector<Triangle> added;
+  for (const Triangle& t : r.triangles)
+    added.push_back({grid.id(t[0]), grid.id(t[1]), grid.id(t[2])});
+  return added;
+}
+
+TEST(HoleFilling, ARunFillsOverPointsItMayNotGrowFromWhereItSeesTheirWholeStars) {
+  // The hole's corners: points 6, 11, 12 and 7.
+  const std::vector<Triangle> filled = fill_loaded_square_hole(std::vector<std::uint8_t>(25, 1));
+  ASSERT_EQ(filled.size(), 2u);
+  for (const Triangle& t : filled) {
+    for (const Index v : t) EXPECT_TRUE(v == 6 || v == 7 || v == 11 || v == 12) << v;
+  }
+  // Points that may neither grow nor fill (a seam's context before): the hole stays.
+  EXPECT_TRUE(fill_loaded_square_hole({}).empty());
+  // A loop with one corner the run may not fill stays open too.
+  std::vector<std::uint8_t> but_one(25, 1);
+  but_one[12] = 0;
+  EXPECT_TRUE(fill_loaded_square_hole(but_one).empty());
+}
+
 TEST(GapClosing, AGapIsNotClosedWhereItWouldFold) {
   // A flat pyramid: three triangles around P, just above the centre of A B X, facing up. Its
   // open edges A->B, B->X, X->A make a three-edge gap, but the triangle closing it would face
