@@ -88,8 +88,9 @@ class SeamStitcher {
       const std::uint32_t s = live.slot(id);
       const bool whole = seam <= reach.context && s != IdMap::kMissing &&
                          (live.flags[s] & LiveMesh::kFinished) == 0;
-      if (s != IdMap::kMissing)
+      if (s != IdMap::kMissing) {
         live.flags[s] |= whole ? LiveMesh::kStarLoaded : LiveMesh::kInContext;
+      }
       ids_.push_back(id);
       growable_.push_back(whole && seam <= band);
       fillable_.push_back(whole);

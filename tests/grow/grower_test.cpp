@@ -3,7 +3,8 @@
 // gap edge's Gabriel point but may not join, so the front itself leaves the gap open. And the
 // removal of scraps (remove_scraps): a lone triangle near a flat patch, and one far from it,
 // grown or loaded before the run. And
-// the cap that closes a piece's only loop with a point left over (cap_single_loops).
+// the cap that closes a piece's only loop with a point left over (cap_single_loops). And hole
+// filling over points a run may fill but not grow from (a seam's live context).
 #include "grow/grower.hpp"
 
 #include <gtest/gtest.h>
