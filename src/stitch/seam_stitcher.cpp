@@ -179,8 +179,8 @@ class SeamStitcher {
 
     MeshOptions mesh_options = options_.mesh;
     mesh_options.progress = {};
-    GrowContext context{preload_, preload_group_,          growable,
-                        links_,   options_.stitch_retries, fillable};
+    GrowContext context{preload_, preload_group_, growable, links_, options_.stitch_retries, {}};
+    context.fillable = fillable;
     context.cloud_spacing = source_.cloud_spacing();
     GrowResult grown = grow_mesh(grid, mesh_options, context);
     const std::vector<std::uint8_t> crossing = crossing_context(grid, grown.triangles);
