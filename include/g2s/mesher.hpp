@@ -42,7 +42,8 @@ struct MeshOptions {
   static constexpr int kMaxHoleEdges = 100;
   // A hole that cannot be filled over its own points (most often because the surface around it
   // folds over it) may be widened by up to this many rings of triangles around it and filled in
-  // their place, leaving out the points inside that lie within 3 spacings of the surface
+  // their place (after r rings its border may have max_hole_edges + 6r edges, at most
+  // kMaxHoleEdges), leaving out the points inside that lie within 3 spacings of the surface
   // (docs/algorithm.md, "Hole filling"); scraps (pieces with no interior point within 3 spacings
   // of another piece) are removed too, when holes are filled at all (max_hole_edges >= 3). 0: every
   // hole is filled over its own loop or not at all, and no point is left out. At most

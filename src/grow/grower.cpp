@@ -808,7 +808,7 @@ class Grower {
       };
       const bool widens = !done && (widen_fan_gaps || !through_fan_gap());
       for (int round = 0; widens && !done && round < max_rings; ++round) {
-        if (!widen(*cells, attempt, holes, dead, max_edges)) break;
+        if (!widen(*cells, attempt, holes, dead, widened_edges(max_edges, round + 1))) break;
         done =
             try_fill(*cells, attempt, scratch, fill) && leaves_out_only_near(attempt, fill, dead);
       }
@@ -836,6 +836,15 @@ class Grower {
       }
     }
     triangles_.insert(triangles_.end(), filled.begin(), filled.end());
+  }
+
+  // How many edges the border of a hole of at most max_edges edges may have once widened by
+  // `rings` rings: six more per ring, as each ring of a regular triangulation (six triangles at
+  // every point) has six more border edges than the one inside it. A hole is admitted by its own
+  // size; its rings are bounded by how such a hole's rings grow, not by that size again.
+  static std::size_t widened_edges(std::size_t max_edges, int rings) {
+    return std::min(max_edges + 6 * static_cast<std::size_t>(rings),
+                    static_cast<std::size_t>(MeshOptions::kMaxHoleEdges));
   }
 
   // An open edge u -> v as its triangle (`triangle`) faces.

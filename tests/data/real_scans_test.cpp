@@ -161,17 +161,19 @@ TEST(RealScanGaps, WideningHolesLeavesFewerHolesAndOnlyPointsNearTheSurfaceOut) 
 // raw-bunny's were measured again (780 -> 817 holes) when gaps between two fans of a point
 // stopped being widened before the non-manifold pass (docs/algorithm.md, "Hole filling"), and
 // raw-bunny, table-mug, lion, autzen and alpe again when widened borders took in the pockets
-// they close around (holes 814 -> 675 on raw-bunny, coverage 0.9857 -> 0.9827).
+// they close around (holes 814 -> 675 on raw-bunny, coverage 0.9857 -> 0.9827), and once more
+// when a widened border could grow by six edges a ring (holes 662 -> 600 on raw-bunny, coverage
+// 0.9827 -> 0.9802).
 INSTANTIATE_TEST_SUITE_P(
     SharedData, RealScan,
     ::testing::Values(Baseline{"closed-kitten", true, 0.995, 0, 0, 0.995},
                       Baseline{"closed-bunny-zipper", true, 0.995, 8, 1, 0.995},
                       Baseline{"open-bunny-scan-bun000", false, 0.9977, 690, 7, 0.995},
-                      Baseline{"raw-bunny", false, 0.9807, 17303, 709, 0.97},
-                      Baseline{"open-table-mug-stereo", false, 0.9921, 5061, 68, 0.97},
-                      Baseline{"open-lion-photogrammetry", false, 0.9917, 16394, 428, 0.97},
-                      Baseline{"open-autzen-lidar", false, 0.9907, 9647, 227, 0.995},
-                      Baseline{"open-alpe-selle-photogrammetry", false, 0.9773, 2478990, 29220,
+                      Baseline{"raw-bunny", false, 0.9781, 16271, 630, 0.97},
+                      Baseline{"open-table-mug-stereo", false, 0.9918, 5022, 65, 0.97},
+                      Baseline{"open-lion-photogrammetry", false, 0.9912, 16184, 407, 0.97},
+                      Baseline{"open-autzen-lidar", false, 0.9904, 9538, 222, 0.995},
+                      Baseline{"open-alpe-selle-photogrammetry", false, 0.9764, 2469269, 28639,
                                0.97}),
     [](const ::testing::TestParamInfo<Baseline>& param) {
       std::string name = param.param.name;
