@@ -635,13 +635,23 @@ class Grower {
   }
 
   // One round of hole filling (fill_holes) and the removal of fillings that cross each other.
+  // A widening that reaches a filling made earlier in the round gives up: the fillings are not
+  // filed for the crossing test until the round ends. In the last round (widen_fan_gaps) the
+  // holes that gave up so are tried once more, alone, with the round's fillings in place; in the
+  // first, the last round tries them again anyway.
   void fill_small_holes(bool widen_fan_gaps) {
-    const auto grown = static_cast<std::uint32_t>(triangles_.size());
-    std::vector<std::uint8_t> dead(grown, 0);
-    fill_holes(dead, widen_fan_gaps);
-    dead.resize(triangles_.size(), 0);
-    remove_crossing_fills(grown, dead);
-    compact(std::move(dead));
+    std::vector<std::uint8_t> retry;  // per point: on the loop of a hole to try again
+    for (int pass = 0; pass < 2; ++pass) {
+      const auto grown = static_cast<std::uint32_t>(triangles_.size());
+      std::vector<std::uint8_t> dead(grown, 0);
+      const std::vector<std::uint8_t> only = std::move(retry);
+      retry.assign(grid_.size(), 0);
+      const bool met_fillings = fill_holes(dead, widen_fan_gaps, only, retry);
+      dead.resize(triangles_.size(), 0);
+      remove_crossing_fills(grown, dead);
+      compact(std::move(dead));
+      if (!widen_fan_gaps || !met_fillings) break;
+    }
   }
 
   // Of every pair of crossing triangles, the one grown later is marked dead (fronts that met
@@ -681,10 +691,14 @@ class Grower {
   // A hole that cannot be filled so (most often because the surface around it folds over it) is
   // widened ring by ring (widen) and filled in place of the rings, if it then can be and the
   // points that leaves out lie close to the surface (leaves_out_only_near); a loop through a
-  // point with several open fans (a gap between them) only with widen_fan_gaps. Appends the
-  // filling triangles to triangles_ and marks the rings kUnlinked in `dead` (sized as
-  // triangles_).
-  void fill_holes(std::vector<std::uint8_t>& dead, bool widen_fan_gaps) {
+  // point with several open fans (a gap between them) only with widen_fan_gaps. Only holes with
+  // a point set in `only` are tried, unless it is empty. Appends the filling triangles to
+  // triangles_ and marks the rings kUnlinked in `dead` (sized as triangles_). Returns whether a
+  // hole gave up because its widening reached a filling of this round, and sets `retry` (sized
+  // as the grid) at such holes' loop points.
+  bool fill_holes(std::vector<std::uint8_t>& dead, bool widen_fan_gaps,
+                  std::span<const std::uint8_t> only, std::vector<std::uint8_t>& retry) {
+    bool met_fillings = false;
     // The grown triangles filed for the crossing test, once a loop needs them. The fillings wait
     // in `filled` until every loop is done, so that the filed triangles stay where they are.
     std::optional<detail::TriangleCells> cells;
@@ -790,6 +804,10 @@ class Grower {
       const Loop& l = loops[i];
       if (!holes.is_hole[i] || holes.taken[i] || l.length > max_edges) continue;
       const std::span<const std::uint32_t> edges = holes.edges_of(i);
+      if (!only.empty() && std::none_of(edges.begin(), edges.end(),
+                                        [&](std::uint32_t e) { return only[open[e].from] != 0; })) {
+        continue;
+      }
       // A ring taken by an earlier loop's filling may have reached this loop.
       if (std::any_of(edges.begin(), edges.end(),
                       [&](std::uint32_t e) { return dead[open[e].triangle] != 0; })) {
@@ -807,12 +825,19 @@ class Grower {
                            [&](Index v) { return open_fans[v] > 1; });
       };
       const bool widens = !done && (widen_fan_gaps || !through_fan_gap());
+      widen_met_filling_ = false;
       for (int round = 0; widens && !done && round < max_rings; ++round) {
         if (!widen(*cells, attempt, holes, dead, widened_edges(max_edges, round + 1))) break;
         done =
             try_fill(*cells, attempt, scratch, fill) && leaves_out_only_near(attempt, fill, dead);
       }
-      if (!done) continue;
+      if (!done) {
+        if (widen_met_filling_) {
+          met_fillings = true;
+          for (const std::uint32_t e : edges) retry[open[e].from] = 1;
+        }
+        continue;
+      }
       for (const std::uint32_t m : attempt.merged) holes.taken[m] = 1;
       const auto [group, flip] = join_groups(attempt.outside);
       for (const std::uint32_t r : attempt.ring) {
@@ -836,6 +861,7 @@ class Grower {
       }
     }
     triangles_.insert(triangles_.end(), filled.begin(), filled.end());
+    return met_fillings;
   }
 
   // How many edges the border of a hole of at most max_edges edges may have once widened by
@@ -1037,7 +1063,10 @@ class Grower {
         std::uint32_t edges = 0;
         std::size_t k = start;
         do {
-          if (border[k].outside == kNoIndex) return false;
+          if (border[k].outside == kNoIndex) {  // a filling of this round, not filed
+            widen_met_filling_ = true;
+            return false;
+          }
           border_loop_[k] = loops;
           ++edges;
           k = leaving(border[k].to);
@@ -1632,6 +1661,7 @@ class Grower {
     detail::Box box;
   };
   std::vector<NearTriangle> loop_near_;
+  bool widen_met_filling_ = false;  // widen gave up at a border edge outside which is a filling
   std::uint32_t last_blocker_ = kNoIndex;  // fill_fits: the place in loop_near_ that refused last
   std::vector<std::uint32_t> near_hits_;   // fill_fits: places in loop_near_ whose boxes overlap
   // An edge of a widened hole's border, as the triangle outside it faces (outside, once found).
