@@ -825,14 +825,15 @@ class Grower {
                            [&](Index v) { return open_fans[v] > 1; });
       };
       const bool widens = !done && (widen_fan_gaps || !through_fan_gap());
-      widen_met_filling_ = false;
+      Widening widening = Widening::widened;
       for (int round = 0; widens && !done && round < max_rings; ++round) {
-        if (!widen(*cells, attempt, holes, dead, widened_edges(max_edges, round + 1))) break;
+        widening = widen(*cells, attempt, holes, dead, widened_edges(max_edges, round + 1));
+        if (widening != Widening::widened) break;
         done =
             try_fill(*cells, attempt, scratch, fill) && leaves_out_only_near(attempt, fill, dead);
       }
       if (!done) {
-        if (widen_met_filling_) {
+        if (widening == Widening::met_filling) {
           met_fillings = true;
           for (const std::uint32_t e : edges) retry[open[e].from] = 1;
         }
@@ -1000,11 +1001,14 @@ class Grower {
   // the border of them all. Where that border would pass a point twice, the point's whole fan
   // joins the ring too; where it would run in more than one loop (the ring closes around a pocket
   // of triangles not in it), the triangles outside every loop but the longest join the ring, so
-  // that the pocket goes with it. Gives up (false, attempt unusable) where the ring would take a
+  // that the pocket goes with it. Gives up (the attempt unusable) where the ring would take a
   // triangle at a point that is not fillable, would reach a piece's outer border or a hole
-  // already filled, or where the border would have more than max_edges edges.
-  bool widen(const detail::TriangleCells& cells, Attempt& attempt, const HoleIndex& holes,
-             const std::vector<std::uint8_t>& dead, std::size_t max_edges) {
+  // already filled, or where the border would have more than max_edges edges (stopped), or
+  // where it would reach a filling made earlier in the round, which is not filed for the
+  // crossing test until the round ends (met_filling).
+  enum class Widening { widened, stopped, met_filling };
+  Widening widen(const detail::TriangleCells& cells, Attempt& attempt, const HoleIndex& holes,
+                 const std::vector<std::uint8_t>& dead, std::size_t max_edges) {
     std::vector<std::uint32_t>& ring = attempt.ring;
     ring.insert(ring.end(), attempt.outside.begin(), attempt.outside.end());
     const std::size_t merged_before = attempt.merged.size();
@@ -1023,7 +1027,7 @@ class Grower {
       std::sort(ring.begin(), ring.end());
       ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
       attempt.merged.resize(merged_before);
-      if (!trace_border(attempt, holes, dead, max_edges)) return false;
+      if (!trace_border(attempt, holes, dead, max_edges)) return Widening::stopped;
       // Points the border passes twice: their fans join the ring.
       std::sort(border.begin(), border.end(),
                 [](const Border& a, const Border& b) { return a.from < b.from; });
@@ -1032,7 +1036,7 @@ class Grower {
         if (border[k].from == border[k - 1].from) pinched_.push_back(border[k].from);
       }
       if (!pinched_.empty()) {
-        if (pass == kMaxWidenPasses) return false;
+        if (pass == kMaxWidenPasses) return Widening::stopped;
         for (const Index v : pinched_) {
           const Vec3f& p = grid_.point(v);
           cells.for_each_near(p, p, [&](std::uint32_t t, const detail::Box&) {
@@ -1063,20 +1067,20 @@ class Grower {
         std::uint32_t edges = 0;
         std::size_t k = start;
         do {
-          if (border[k].outside == kNoIndex) {  // a filling of this round, not filed
-            widen_met_filling_ = true;
-            return false;
-          }
+          // No triangle outside among those filed: a filling of this round.
+          if (border[k].outside == kNoIndex) return Widening::met_filling;
           border_loop_[k] = loops;
           ++edges;
           k = leaving(border[k].to);
-          if (k == border.size() || (k != start && border_loop_[k] != kNoIndex)) return false;
+          if (k == border.size() || (k != start && border_loop_[k] != kNoIndex)) {
+            return Widening::stopped;
+          }
         } while (k != start);
         if (edges > outer_edges) outer = loops, outer_edges = edges, outer_start = start;
         ++loops;
       }
       if (loops == 1) break;
-      if (pass == kMaxWidenPasses) return false;
+      if (pass == kMaxWidenPasses) return Widening::stopped;
       for (std::size_t k = 0; k < border.size(); ++k) {
         if (border_loop_[k] != outer) ring.push_back(border[k].outside);
       }
@@ -1091,7 +1095,7 @@ class Grower {
       attempt.add_edge(e.from, e.outside, facing_normal(e.outside));
       k = leaving(e.to);
     } while (k != outer_start);
-    return true;
+    return Widening::widened;
   }
 
   // The border of the attempt's ring and holes (border_, unordered): ring edges with a triangle
@@ -1661,7 +1665,6 @@ class Grower {
     detail::Box box;
   };
   std::vector<NearTriangle> loop_near_;
-  bool widen_met_filling_ = false;  // widen gave up at a border edge outside which is a filling
   std::uint32_t last_blocker_ = kNoIndex;  // fill_fits: the place in loop_near_ that refused last
   std::vector<std::uint32_t> near_hits_;   // fill_fits: places in loop_near_ whose boxes overlap
   // An edge of a widened hole's border, as the triangle outside it faces (outside, once found).
