@@ -228,6 +228,7 @@ class Grower {
                     bool grow = true) {
     const auto t = static_cast<std::uint32_t>(triangles_.size());
     triangles_.push_back({a, b, c});
+    pieces_stale_ = true;
     group_.push_back(group);
     flip_.push_back(flip);
     const Index corners[3] = {a, b, c};
@@ -351,7 +352,7 @@ class Grower {
   // cube give two opposite faces, each a scrap): they stay.
   void remove_scraps() {
     const auto n = static_cast<std::uint32_t>(grid_.size());
-    const std::vector<std::uint32_t> piece = pieces();
+    const std::vector<std::uint32_t>& piece = pieces();
     // A piece may go unless it has an interior point (one on no open edge) or a point this run
     // does not judge.
     std::vector<std::uint8_t> on_open(n, 0), keep(n, 0);
@@ -489,6 +490,7 @@ class Grower {
         for (const Triangle& t : fan) {
           const auto id = static_cast<std::uint32_t>(triangles_.size());
           triangles_.push_back(t);
+          pieces_stale_ = true;
           group_.push_back(group);
           flip_.push_back(flip);
           for (int k = 0; k < 3; ++k) edges_.add(t[k], t[(k + 1) % 3], id);
@@ -586,10 +588,15 @@ class Grower {
   }
 
   // Per point, the surface piece it is a corner of (a representative point of it: the triangles
-  // sharing corners are one piece), or kNoIndex for a point no triangle uses.
-  std::vector<std::uint32_t> pieces() const {
+  // sharing corners are one piece), or kNoIndex for a point no triangle uses. Worked out again
+  // only after the triangles changed (pieces_stale_): the finishing asks up to five times, and on
+  // a clean tile nothing changes between them.
+  const std::vector<std::uint32_t>& pieces() {
+    if (!pieces_stale_) return piece_of_;
+    pieces_stale_ = false;
     const auto n = static_cast<std::uint32_t>(grid_.size());
-    std::vector<std::uint32_t> piece(n, kNoIndex);
+    std::vector<std::uint32_t>& piece = piece_of_;
+    piece.assign(n, kNoIndex);
     for (const Triangle& t : triangles_) {
       for (const Index v : t) piece[v] = v;
     }
@@ -629,6 +636,7 @@ class Grower {
     }
     preloaded_ = kept_loaded;
     preload_index_.resize(kept_loaded);
+    pieces_stale_ = pieces_stale_ || kept != triangles_.size();
     triangles_.resize(kept);
     group_.resize(kept);
     flip_.resize(kept);
@@ -733,7 +741,7 @@ class Grower {
       std::uint32_t begin, length, component;
       bool closable;
     };
-    const std::vector<std::uint32_t> piece = pieces();
+    const std::vector<std::uint32_t>& piece = pieces();
     std::vector<Loop> loops;
     std::vector<std::uint32_t> loop_edges, trace;
     std::vector<std::uint8_t> taken(open.size(), 0);
@@ -862,6 +870,7 @@ class Grower {
       }
     }
     triangles_.insert(triangles_.end(), filled.begin(), filled.end());
+    pieces_stale_ = pieces_stale_ || !filled.empty();
     return met_fillings;
   }
 
@@ -1621,8 +1630,10 @@ class Grower {
     std::uint8_t flip;
   };
   std::vector<RemovedPreload> removed_preload_;
-  std::vector<std::uint32_t> group_;  // per triangle: its orientation group
-  std::vector<std::uint8_t> flip_;    // per triangle: its parity within the group
+  std::vector<std::uint32_t> group_;     // per triangle: its orientation group
+  std::vector<std::uint8_t> flip_;       // per triangle: its parity within the group
+  std::vector<std::uint32_t> piece_of_;  // pieces(), while !pieces_stale_
+  bool pieces_stale_ = true;
   ParityUnionFind groups_;
   std::vector<Index> second_fans_;
   EdgeMap edges_;
