@@ -1,4 +1,4 @@
-// Crossing triangles (crossings.hpp): the search by the empty-ball argument over the triangles on
+// Crossing triangles (crossings.hpp): the guard by the empty-ball argument over the triangles on
 // each vertex, and triangles filed by the cell of their box's lower corner in levels of cells;
 // the pair test is the exact one of common/triangle_intersection.hpp.
 #include "grow/crossings.hpp"
@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "common/exact_predicates.hpp"
 #include "common/separating_planes.hpp"
@@ -52,127 +53,56 @@ Pairs sorted_union(tbb::enumerable_thread_specific<Pairs>& found) {
 }
 }  // namespace
 
-Pairs find_crossings(const HashGrid& grid, std::span<const Triangle> triangles, std::size_t fixed) {
-  const std::size_t n = grid.size();
-  // Per point: used by some triangle (kCorner), and by one not fixed (kFreeCorner as well).
-  constexpr std::uint8_t kCorner = 1, kFreeCorner = 2;
-  std::vector<std::uint8_t> vertex(n, 0);
-  for (std::size_t t = 0; t < triangles.size(); ++t) {
-    for (const Index v : triangles[t]) vertex[v] |= t < fixed ? kCorner : kCorner | kFreeCorner;
-  }
-  const auto ball_of = [&](const Triangle& t, Ball& ball) {
-    return padded_circumball(grid.position(t[0]), grid.position(t[1]), grid.position(t[2]), ball);
-  };
-  // The vertices in each triangle's ball (its corners aside): none certifies it. The lists of
-  // the uncertified ones are kept, as runs in their thread's array.
-  struct Run {
-    std::uint32_t triangle, begin, end;
-  };
-  struct Inside {
-    std::vector<Index> vertices;
-    std::vector<Run> runs;
-  };
-  tbb::enumerable_thread_specific<Inside> inside;
-  std::vector<std::uint8_t> has_ball(triangles.size(), 0);
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, triangles.size(), 1024),
-      [&](const tbb::blocked_range<std::size_t>& range) {
-        Inside& local = inside.local();
-        for (std::size_t t = range.begin(); t < range.end(); ++t) {
-          const Triangle& tri = triangles[t];
-          Ball ball;
-          if (!ball_of(tri, ball)) continue;
-          has_ball[t] = 1;
-          const auto begin = static_cast<std::uint32_t>(local.vertices.size());
-          const std::uint8_t wanted = t < fixed ? kFreeCorner : kCorner;
-          grid.for_each_in_ball(ball.centre, std::sqrt(ball.radius2), [&](std::uint32_t j, double) {
-            if (j != tri[0] && j != tri[1] && j != tri[2] && (vertex[j] & wanted)) {
-              local.vertices.push_back(j);
-            }
-          });
-          const auto end = static_cast<std::uint32_t>(local.vertices.size());
-          if (end > begin) local.runs.push_back({static_cast<std::uint32_t>(t), begin, end});
-        }
-      });
-  std::vector<std::pair<const Inside*, Run>> uncertified;
-  for (const Inside& part : inside) {
-    for (const Run& run : part.runs) uncertified.push_back({&part, run});
-  }
-  if (uncertified.empty()) return {};
-  std::vector<std::uint8_t> uncertified_triangle(triangles.size(), 0);
-  for (const auto& [part, run] : uncertified) uncertified_triangle[run.triangle] = 1;
-  // The stars of the vertices in some uncertified ball: per such vertex, the triangles on it
-  // (counting sort, in triangle order).
-  std::vector<std::uint8_t> needed(n, 0);
-  for (const Inside& part : inside) {
-    for (const Index v : part.vertices) needed[v] = 1;
-  }
-  std::vector<std::uint32_t> star_begin(n + 1, 0);
-  for (const Triangle& t : triangles) {
-    for (const Index v : t) star_begin[v + 1] += needed[v];
-  }
-  for (std::size_t v = 0; v < n; ++v) star_begin[v + 1] += star_begin[v];
-  std::vector<std::uint32_t> star(star_begin[n]);
-  {
-    std::vector<std::uint32_t> at(star_begin.begin(), star_begin.end() - 1);
-    for (std::uint32_t t = 0; t < triangles.size(); ++t) {
-      for (const Index v : triangles[t]) {
-        if (needed[v]) star[at[v]++] = t;
-      }
-    }
-  }
-  // Each uncertified triangle against the triangles on the vertices in its ball. A pair where
-  // each ball holds a corner of the other is met from both sides; the larger index leaves it
-  // to the smaller.
-  const auto holds_corner_of = [&](const Triangle& s, const Triangle& t) {
-    Ball ball;
-    ball_of(s, ball);
-    const HashGrid::BallQuery query(grid, ball.centre, std::sqrt(ball.radius2));  // as s's search
-    for (const Index v : t) {
-      if (v != s[0] && v != s[1] && v != s[2] && query.visits(grid, v)) return true;
-    }
+CrossingGuard::CrossingGuard(const HashGrid& grid)
+    : grid_(grid), star_head_(grid.size(), kNoIndex), held_head_(grid.size(), kNoIndex) {}
+
+bool CrossingGuard::gather(const Triangle& tri) {
+  gathered_ = tri;
+  in_ball_.clear();
+  Ball ball;
+  if (!padded_circumball(grid_.position(tri[0]), grid_.position(tri[1]), grid_.position(tri[2]),
+                         ball)) {
     return false;
+  }
+  grid_.for_each_in_ball(ball.centre, std::sqrt(ball.radius2), [&](std::uint32_t j, double) {
+    if (j != tri[0] && j != tri[1] && j != tri[2]) in_ball_.push_back(j);
+  });
+  return true;
+}
+
+bool CrossingGuard::crosses(const Triangle& tri, std::span<const Triangle> made) {
+  if (!gather(tri)) return true;
+  std::optional<SeparatingPlanes> planes;
+  const auto crosses_one = [&](std::uint32_t other) {
+    if (!planes) planes.emplace(grid_.points(), tri);
+    return !planes->separate(grid_.points(), made[other]) &&
+           triangles_cross(grid_.points(), tri, made[other]);
   };
-  tbb::enumerable_thread_specific<Pairs> found;
-  tbb::enumerable_thread_specific<std::vector<std::uint32_t>> scratch;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, uncertified.size(), 256),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      Pairs& pairs = found.local();
-                      std::vector<std::uint32_t>& near = scratch.local();
-                      for (std::size_t u = range.begin(); u < range.end(); ++u) {
-                        const auto& [part, run] = uncertified[u];
-                        const std::uint32_t id = run.triangle;
-                        const Triangle& tri = triangles[id];
-                        const Box box = box_of(grid.points(), tri);
-                        near.clear();
-                        for (std::uint32_t k = run.begin; k < run.end; ++k) {
-                          const Index v = part->vertices[k];
-                          for (std::uint32_t s = star_begin[v]; s < star_begin[v + 1]; ++s) {
-                            const std::uint32_t other = star[s];
-                            if (other == id || !has_ball[other]) continue;
-                            if (id < fixed && other < fixed) continue;
-                            if (overlap(box, box_of(grid.points(), triangles[other]))) {
-                              near.push_back(other);
-                            }
-                          }
-                        }
-                        if (near.empty()) continue;
-                        std::sort(near.begin(), near.end());
-                        near.erase(std::unique(near.begin(), near.end()), near.end());
-                        const SeparatingPlanes planes(grid.points(), tri);
-                        for (const std::uint32_t other : near) {
-                          if (planes.separate(grid.points(), triangles[other])) continue;
-                          if (other < id && uncertified_triangle[other] &&
-                              holds_corner_of(triangles[other], tri)) {
-                            continue;
-                          }
-                          if (triangles_cross(grid.points(), tri, triangles[other])) {
-                            pairs.push_back({std::min(id, other), std::max(id, other)});
-                          }
-                        }
-                      }
-                    });
-  return sorted_union(found);
+  for (const Index v : in_ball_) {
+    for (std::uint32_t at = star_head_[v]; at != kNoIndex; at = star_next_[at]) {
+      if (crosses_one(at / 3)) return true;
+    }
+  }
+  for (const Index v : tri) {
+    for (std::uint32_t at = held_head_[v]; at != kNoIndex; at = held_[at].next) {
+      if (crosses_one(held_[at].triangle)) return true;
+    }
+  }
+  return false;
+}
+
+void CrossingGuard::file(std::uint32_t t, std::span<const Triangle> made) {
+  const Triangle& tri = made[t];
+  if (tri != gathered_) gather(tri);
+  star_next_.resize(3 * std::size_t{t} + 3, kNoIndex);
+  for (int k = 0; k < 3; ++k) {
+    star_next_[3 * std::size_t{t} + k] = star_head_[tri[k]];
+    star_head_[tri[k]] = 3 * t + static_cast<std::uint32_t>(k);
+  }
+  for (const Index v : in_ball_) {
+    held_.push_back({t, held_head_[v]});
+    held_head_[v] = static_cast<std::uint32_t>(held_.size() - 1);
+  }
 }
 
 Pairs TriangleCells::crossing_pairs() const {

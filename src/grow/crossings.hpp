@@ -1,8 +1,7 @@
-// Crossing triangles among the triangles of one growth run: pairs that meet other than in a
-// shared corner or a shared edge. The grower removes one triangle of each pair once growth is
-// over (find_crossings), and checks the triangles it fills holes with against the rest
-// (TriangleCells), so that no mesh it makes crosses itself (docs/algorithm.md, "No crossing
-// triangles").
+// Crossing triangles: pairs that meet other than in a shared corner or a shared edge. The grower
+// makes no triangle that crosses one made before (CrossingGuard), and checks the triangles it
+// fills holes with against the rest (TriangleCells), so that no mesh it makes crosses itself
+// (docs/algorithm.md, "No crossing triangles").
 #pragma once
 
 #include <algorithm>
@@ -49,25 +48,45 @@ inline Box box_of(std::span<const Vec3f> points, const Triangle& t) {
   return enclose(enclose(corner, points[t[1]]), points[t[2]]);
 }
 
-// Every pair (s, t), s < t, sorted, of triangles with a circumball that cross
-// (triangles_cross); a triangle without one (has_circumball: a sliver under ~0.006°, which the
-// grower never makes) is not searched. Found by this fact:
-// two triangles, each with the corners it does not share with the other outside the other's
-// padded circumball (padded_circumball), never cross. The difference of a point's powers with
-// respect to the two spheres is an affine function, positive at one triangle's other corners
-// and negative at the other's, so the triangles can meet only where it vanishes, in the
-// corners they share. So a triangle whose ball holds no vertex (a point some triangle uses) is
-// certified, and the others are tested against the triangles on the vertices in their balls;
-// on a clean scan nearly every triangle is certified. Points no triangle uses play no part, so
-// noise left out of the mesh does not spoil a certificate.
-// Inputs: grid (its points are the corners), triangles, and `fixed`: the first `fixed`
-// triangles are kept whatever crosses them (a seam's preload), so no pair of two of them is
-// wanted. A fixed triangle's ball then needs to hold a corner of another triangle to leave it
-// uncertified: the argument above still finds every pair with one triangle not fixed. Cost:
-// one ball query per triangle (the vertices found in the balls of uncertified ones are kept,
-// and only their stars are built); the pairs are the same for any thread count.
-std::vector<std::pair<std::uint32_t, std::uint32_t>> find_crossings(
-    const HashGrid& grid, std::span<const Triangle> triangles, std::size_t fixed = 0);
+// Triangles made one at a time, none crossing another (triangles_cross): the grower asks about
+// each triangle before making it. By this fact: two triangles, each with the corners it does
+// not share with the other outside the other's padded circumball (padded_circumball), never
+// cross. The difference of a point's powers with respect to the two spheres is an affine
+// function, positive at one triangle's other corners and negative at the other's, so the
+// triangles can meet only where it vanishes, in the corners they share. So a new triangle needs
+// testing only against the triangles on the vertices in its ball and those whose balls hold one
+// of its corners; on a clean scan both lists are nearly always empty. Per point the guard keeps
+// the triangles on it and the triangles whose balls hold it (flat lists threaded through two
+// arrays, no allocation per triangle).
+// Cost: one ball query per triangle asked about (file reuses the last), and the exact test only
+// where the separating planes (common/separating_planes.hpp) do not settle a pair.
+class CrossingGuard {
+ public:
+  // Inputs: the grid whose points the triangles' corners index. It must outlive the guard.
+  explicit CrossingGuard(const HashGrid& grid);
+  // Inputs: a triangle with a circumball (not filed), and `made`, the triangles filed so far by
+  // their indices. Output: whether it crosses a filed triangle (true also for a sliver without
+  // a circumball, which the grower never makes).
+  bool crosses(const Triangle& tri, std::span<const Triangle> made);
+  // Files made[t], a triangle made without crossing a filed one (or one kept whatever crosses
+  // it, such as a seam's preload; crosses() need not have been asked).
+  void file(std::uint32_t t, std::span<const Triangle> made);
+
+ private:
+  // The points other than its corners in tri's padded circumball, into in_ball_ (none for a
+  // sliver); false for a sliver.
+  bool gather(const Triangle& tri);
+  struct Held {
+    std::uint32_t triangle, next;
+  };
+  const HashGrid& grid_;
+  std::vector<std::uint32_t> star_head_;  // per point: its last corner slot 3t+k, or kNoIndex
+  std::vector<std::uint32_t> star_next_;  // per corner slot: the point's corner filed before
+  std::vector<std::uint32_t> held_head_;  // per point: its last entry in held_, or kNoIndex
+  std::vector<Held> held_;
+  std::vector<Index> in_ball_;
+  Triangle gathered_{kNoIndex, kNoIndex, kNoIndex};  // the triangle in_ball_ is of
+};
 
 // Triangles filed by the cell of their bounding box's lower corner, in levels of cells each 8
 // times larger than the one before: a triangle is filed in the first level whose cell its box

@@ -3,7 +3,8 @@
 // Gabriel walk picks the point whose smallest circumscribing ball with the edge holds no other
 // candidate; the discrete priority queue (radius level, then flatness level) meshes the flattest,
 // best-sampled regions first; the Point-Edge Map keeps every edge manifold and every pair of
-// neighbouring triangles consistently oriented.
+// neighbouring triangles consistently oriented, and the crossing guard refuses a triangle that
+// would cross one made before.
 #include "grow/grower.hpp"
 
 #include <tbb/blocked_range.h>
@@ -74,6 +75,7 @@ class Grower {
         flat_levels_(std::max(1, options.flatness_levels)),
         edges_(grid.size()),
         seed_tried_(grid.size(), 0),
+        guard_(std::in_place, grid),
         state_(grid.size(), 0),
         queue_(std::max(1, levels_ * flat_levels_)),
         last_priority_(std::max(1, levels_ * flat_levels_) - 1),
@@ -229,6 +231,7 @@ class Grower {
     const auto t = static_cast<std::uint32_t>(triangles_.size());
     triangles_.push_back({a, b, c});
     pieces_stale_ = true;
+    guard_->file(t, triangles_);
     group_.push_back(group);
     flip_.push_back(flip);
     const Index corners[3] = {a, b, c};
@@ -304,9 +307,9 @@ class Grower {
     stalled_ = {};
   }
 
-  // Once growth is over: no crossing triangles, small holes filled, and the points with more
-  // than one fan left to a single one, with the holes that leaves filled in turn
-  // (docs/algorithm.md, "No crossing triangles" and "Hole filling"). Filling first lets a hole
+  // Once growth is over (which made no crossing triangle): small holes filled, and the points
+  // with more than one fan left to a single one, with the holes that leaves filled in turn
+  // (docs/algorithm.md, "Hole filling"). Filling first lets a hole
   // between two fans of a point join them, where deleting one fan would leave a larger hole;
   // such a gap is not widened in that first round (most widenings of one fail, at a tenth of the
   // run on alpe): the non-manifold pass keeps one fan, and the second round widens what that
@@ -314,7 +317,7 @@ class Grower {
   // border is a short loop is closed with a point left over, where that makes a closed surface
   // (cap_single_loops).
   void finish_surface() {
-    compact(remove_crossings());
+    guard_.reset();  // growth is over
     if (options_.max_hole_edges < 3) return;
     fill_small_holes(/*widen_fan_gaps=*/false);
     // Points whose whole star is in this run: growable, and no corner of a triangle kept from
@@ -660,26 +663,6 @@ class Grower {
       compact(std::move(dead));
       if (!widen_fan_gaps || !met_fillings) break;
     }
-  }
-
-  // Of every pair of crossing triangles, the one grown later is marked dead (fronts that met
-  // between the layers of a noisy scan). Triangles loaded before the run are never removed.
-  // Corners of removed triangles become suspects of the non-manifold pass.
-  std::vector<std::uint8_t> remove_crossings() {
-    std::vector<std::uint8_t> dead(triangles_.size(), 0);
-    for (const auto& [first, second] : detail::find_crossings(grid_, triangles_, preloaded_)) {
-      if (dead[first] || dead[second]) continue;
-      if (second >= preloaded_) {
-        dead[second] = 1;
-      } else if (first >= preloaded_) {
-        dead[first] = 1;
-      }
-    }
-    for (std::uint32_t t = 0; t < triangles_.size(); ++t) {
-      if (dead[t])
-        second_fans_.insert(second_fans_.end(), triangles_[t].begin(), triangles_[t].end());
-    }
-    return dead;
   }
 
   // The triangle as it will face once its group's orientation is applied.
@@ -1536,8 +1519,8 @@ class Grower {
       if ((on_pb & EdgeMap::kClosed) || on_pb == e.triangle) return false;
       if (on_pb == on_ap) return false;
     }
-    // No sliver: every triangle the grower makes has a circumball, so the crossing search
-    // (detail::find_crossings) covers them all.
+    // No sliver: every triangle the grower makes has a circumball, so the guard's argument
+    // covers them all.
     const Vec3 a = grid_.position(e.a), b = grid_.position(e.b);
     if (!has_circumball(a, b, grid_.position(p))) return false;
     const Vec3 n_new = normalized(cross(a - b, grid_.position(p) - b));
@@ -1551,6 +1534,8 @@ class Grower {
       const double facing = traverses(triangles_[on_pb], e.b, p) ? 1.0 : -1.0;
       if (facing * dot(n_new, normal_of(on_pb)) < cos_max_fold_) return false;
     }
+    // No triangle that crosses one made before (docs/algorithm.md, "No crossing triangles").
+    if (guard_->crosses({e.b, e.a, p}, triangles_)) return false;
     if (!join_groups(e.triangle, e.a, p, e.b, on_ap, on_pb)) return false;
     if (used(p) && on_ap == EdgeMap::kMissing && on_pb == EdgeMap::kMissing) {
       second_fans_.push_back(p);
@@ -1608,6 +1593,7 @@ class Grower {
         below |= h < -slack;
       }
       if (above && below) continue;
+      if (guard_->crosses({i, q, r}, triangles_)) continue;
       add_triangle(i, q, r, groups_.add(), 0);
       return true;
     }
@@ -1638,6 +1624,7 @@ class Grower {
   std::vector<Index> second_fans_;
   EdgeMap edges_;
   std::vector<std::uint8_t> seed_tried_;
+  std::optional<detail::CrossingGuard> guard_;  // while growth lasts
   // Per point: kUsed once it is a corner, plus the number of open edges at it; one array, so
   // that the interior test of every point a search ball holds is a single load.
   static constexpr std::uint32_t kUsed = 0x80000000u;

@@ -1,8 +1,9 @@
-// The grower's search for crossing triangles (src/grow/crossings.hpp): find_crossings and
-// TriangleCells must find exactly the pairs a test of every pair finds, and TriangleCells with
-// separating planes exactly the triangles a new one crosses, on soups of small and large triangles
-// where many cross, on every triangle of nearby points in a random cloud, and where four points
-// lie on one circle.
+// The grower's tests for crossing triangles (src/grow/crossings.hpp): CrossingGuard must refuse
+// exactly the triangles that a test against every triangle made before refuses, TriangleCells
+// must find exactly the pairs a test of every pair finds, and TriangleCells with separating
+// planes exactly the triangles a new one crosses, on soups of small and large triangles where
+// many cross, on every triangle of nearby points in a random cloud, and where four points lie on
+// one circle.
 #include "grow/crossings.hpp"
 
 #include <gtest/gtest.h>
@@ -70,6 +71,32 @@ Pairs brute_force_pairs(const Soup& soup) {
   return pairs;
 }
 
+// The triangles refused when each is asked about in turn and the others made, the first `fixed`
+// made without asking (a seam's preload): by a guard, or by a test against every one made.
+std::vector<std::uint32_t> refusals(const Soup& soup, std::size_t fixed, bool brute_force) {
+  detail::CrossingGuard guard(soup.grid);
+  std::vector<Triangle> made;
+  std::vector<std::uint32_t> refused;
+  for (std::uint32_t t = 0; t < soup.triangles.size(); ++t) {
+    const Triangle& tri = soup.triangles[t];
+    bool crosses = false;
+    if (t >= fixed && brute_force) {
+      for (const Triangle& o : made) {
+        crosses = crosses || detail::triangles_cross(soup.grid.points(), tri, o);
+      }
+    } else if (t >= fixed) {
+      crosses = guard.crosses(tri, made);
+    }
+    if (crosses) {
+      refused.push_back(t);
+      continue;
+    }
+    made.push_back(tri);
+    guard.file(static_cast<std::uint32_t>(made.size() - 1), made);
+  }
+  return refused;
+}
+
 // Whether triangle t crosses a filed triangle, as the grower's hole filling asks: the filed
 // triangles whose boxes overlap t's, t's separating planes, then the exact test.
 bool cells_say_crosses(const Soup& soup, const detail::TriangleCells& cells,
@@ -90,29 +117,27 @@ bool cells_say_crosses(const Soup& soup, const detail::TriangleCells& cells,
   return crosses;
 }
 
-TEST(Crossings, BothSearchesFindExactlyThePairsOfABruteForceSearch) {
+TEST(Crossings, TheGuardAndTheCellsAnswerAsATestOfEveryPair) {
   for (const int large_every : {0, 7}) {
     const Soup soup = random_soup(600, large_every, 11u + static_cast<unsigned>(large_every));
     const Pairs expected = brute_force_pairs(soup);
     ASSERT_GT(expected.size(), 50u) << "the soup must cross itself to test anything";
-    EXPECT_EQ(detail::find_crossings(soup.grid, soup.triangles), expected);
+    const std::vector<std::uint32_t> refused = refusals(soup, 0, true);
+    ASSERT_GT(refused.size(), 30u);
+    EXPECT_EQ(refusals(soup, 0, false), refused);
     EXPECT_EQ(detail::TriangleCells(soup.grid.points(), soup.triangles).crossing_pairs(), expected);
   }
 }
 
-// With the first triangles fixed (a seam's preload), every crossing pair with a triangle not
-// fixed is still found, and no pair of two fixed ones is.
-TEST(Crossings, FixedTrianglesArePairedOnlyWithTheOthers) {
+// Triangles made without asking (a seam's preload, which may cross itself) still refuse every
+// later triangle that crosses them.
+TEST(Crossings, TrianglesMadeWithoutAskingAreGuardedAgainst) {
   for (const int large_every : {0, 7}) {
     const Soup soup = random_soup(600, large_every, 5u + static_cast<unsigned>(large_every));
-    const Pairs all = brute_force_pairs(soup);
-    for (const std::size_t fixed : {std::size_t{0}, std::size_t{150}, std::size_t{450}}) {
-      Pairs expected;
-      for (const auto& pair : all) {
-        if (pair.second >= fixed) expected.push_back(pair);
-      }
-      ASSERT_GT(expected.size(), 10u);
-      EXPECT_EQ(detail::find_crossings(soup.grid, soup.triangles, fixed), expected) << fixed;
+    for (const std::size_t fixed : {std::size_t{150}, std::size_t{450}}) {
+      const std::vector<std::uint32_t> refused = refusals(soup, fixed, true);
+      ASSERT_GT(refused.size(), 10u);
+      EXPECT_EQ(refusals(soup, fixed, false), refused) << fixed;
     }
   }
 }
@@ -157,10 +182,10 @@ TEST(Crossings, CellsWithSeparatingPlanesFindEveryTriangleANewOneCrosses) {
   }
 }
 
-TEST(Crossings, ASliverHasNoCircumballAndIsNotSearched) {
+TEST(Crossings, ASliverHasNoCircumballAndIsRefused) {
   // A sliver under 0.006 degrees, folded flat onto its neighbour across their shared edge: the
-  // pair crosses, but the sliver has no circumball (the grower never makes one), so the search
-  // leaves it out.
+  // pair crosses, but the sliver has no circumball for the guard's argument (the grower never
+  // makes one), so the guard refuses it whatever it crosses.
   const std::vector<float> xyz = {0, 0, 0, 1, 0, 0, 0.5f, 1e-7f, 0, 0.5f, 1, 0};
   const Soup soup = soup_of(xyz, {{0, 1, 3}, {0, 1, 2}});
   const Triangle& sliver = soup.triangles[1];
@@ -168,7 +193,8 @@ TEST(Crossings, ASliverHasNoCircumballAndIsNotSearched) {
                               soup.grid.position(sliver[2])));
   ASSERT_FALSE(detail::degenerate(soup.grid.points(), sliver));
   ASSERT_TRUE(detail::triangles_cross(soup.grid.points(), soup.triangles[0], sliver));
-  EXPECT_TRUE(detail::find_crossings(soup.grid, soup.triangles).empty());
+  detail::CrossingGuard guard(soup.grid);
+  EXPECT_TRUE(guard.crosses(sliver, {}));
 }
 
 TEST(Crossings, SharedEdgesAndCornersAreNotCrossings) {
@@ -186,9 +212,9 @@ TEST(Crossings, SharedEdgesAndCornersAreNotCrossings) {
 }
 
 TEST(Crossings, EveryCrossingAmongTheTrianglesOfACloudIsFound) {
-  // Every triangle of nearby points in a random cloud: they cross plenty, and each pair an index
-  // of them reports is one a test of every pair finds. Then with one point in four left out
-  // (no triangle uses it, and it must not count against a ball).
+  // Every triangle of nearby points in a random cloud: they cross plenty, and the guard refuses
+  // exactly what a test against every triangle made refuses. Then with one point in four left
+  // out (no triangle uses it, and it must not count against a ball).
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> where(0, 1);
   std::vector<float> xyz;
@@ -210,22 +236,23 @@ TEST(Crossings, EveryCrossingAmongTheTrianglesOfACloudIsFound) {
       }
     }
     const Soup soup = soup_of(xyz, std::move(triangles));
-    const Pairs expected = brute_force_pairs(soup);
-    EXPECT_GT(expected.size(), 300u);
-    EXPECT_EQ(detail::find_crossings(soup.grid, soup.triangles), expected);
+    const std::vector<std::uint32_t> refused = refusals(soup, 0, true);
+    EXPECT_GT(refused.size(), 50u);
+    EXPECT_EQ(refusals(soup, 0, false), refused);
   }
 }
 
 TEST(Crossings, FourPointsOnOneCircleAreSearched) {
   // A square's corners lie on one circle: each of its four triangles has the fourth corner on
   // its ball's sphere, and the two ways to split the square overlap. A point exactly on the
-  // sphere must count as inside, or the overlaps would go unsearched.
+  // sphere must count as inside, or the overlaps would go unsearched: one split is made, both
+  // triangles of the other refused.
   const std::vector<float> square = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
   const std::vector<Triangle> four = {{0, 1, 2}, {0, 2, 3}, {0, 1, 3}, {1, 2, 3}};
   const Soup soup = soup_of(square, four);
-  const Pairs expected = brute_force_pairs(soup);
-  ASSERT_EQ(expected.size(), 4u);  // each split against each triangle of the other
-  EXPECT_EQ(detail::find_crossings(soup.grid, soup.triangles), expected);
+  ASSERT_EQ(brute_force_pairs(soup).size(), 4u);  // each split against each triangle of the other
+  EXPECT_EQ(refusals(soup, 0, false), (std::vector<std::uint32_t>{2, 3}));
+  EXPECT_EQ(refusals(soup, 0, true), (std::vector<std::uint32_t>{2, 3}));
 }
 
 }  // namespace
