@@ -56,8 +56,8 @@ inline Box box_of(std::span<const Vec3f> points, const Triangle& t) {
 // triangles can meet only where it vanishes, in the corners they share. So a new triangle needs
 // testing only against the triangles on the vertices in its ball and those whose balls hold one
 // of its corners; on a clean scan both lists are nearly always empty. Per point the guard keeps
-// the triangles on it and the triangles whose balls hold it (flat lists threaded through two
-// arrays, no allocation per triangle).
+// the triangles on it and the triangles whose balls hold it (lists threaded through flat arrays
+// that grow with the triangles, no allocation of its own per triangle).
 // Cost: one ball query per triangle asked about (file reuses the last), and the exact test only
 // where the separating planes (common/separating_planes.hpp) do not settle a pair.
 class CrossingGuard {

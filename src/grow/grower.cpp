@@ -225,7 +225,8 @@ class Grower {
   }
 
   // Appends triangle (a, b, c) in orientation group `group` and updates the Point-Edge Map, the
-  // open-edge counts and (when `grow`) the front.
+  // open-edge counts, the crossing guard (growth only: add_triangle is not called after it) and
+  // (when `grow`) the front.
   void add_triangle(Index a, Index b, Index c, std::uint32_t group, std::uint8_t flip,
                     bool grow = true) {
     const auto t = static_cast<std::uint32_t>(triangles_.size());
