@@ -90,7 +90,7 @@ std::string why_tile_too_wide(const TileSource& source) {
   for (const TileInfo& t : source.tiles()) {
     double half_width = 0.0;
     for (int a = 0; a < 3; ++a)
-      half_width = std::max(half_width, 0.5 * (t.box.hi[a] - t.box.lo[a]));
+      half_width = std::max(half_width, 0.5 * (t.points_box.hi[a] - t.points_box.lo[a]));
     const double step = half_width * std::numeric_limits<float>::epsilon();
     if (t.points > 1 && t.spacing > 0.0 && step > 0.1 * t.spacing) {
       return fmt::format(
@@ -125,6 +125,30 @@ std::string why_no_surface(const TileSource& source, bool& all_float) {
     first_pass = false;
   });
   if (why.empty()) return {};
+  // Stray points far from the rest stretch the extent the check measures collinearity against
+  // (a millionth of it); the tiles keep them apart (kStrayGap), and each tile is meshed in a
+  // float frame of its own. So a tile far narrower than the cloud whose own points make a
+  // surface is enough.
+  const auto widest = [](const TileBox& box) {
+    return std::max({box.hi[0] - box.lo[0], box.hi[1] - box.lo[1], box.hi[2] - box.lo[2]});
+  };
+  TileBox all;  // of every tile's points
+  bool any = false;
+  for (const TileInfo& t : source.tiles()) {
+    if (t.points == 0) continue;
+    for (int a = 0; a < 3; ++a) {
+      all.lo[a] = any ? std::min(all.lo[a], t.points_box.lo[a]) : t.points_box.lo[a];
+      all.hi[a] = any ? std::max(all.hi[a], t.points_box.hi[a]) : t.points_box.hi[a];
+    }
+    any = true;
+  }
+  for (std::size_t t = 0; t < source.tiles().size(); ++t) {
+    const TileInfo& tile = source.tiles()[t];
+    if (tile.points < 3 || kStrayGap * widest(tile.points_box) > widest(all)) continue;
+    const TilePoints points = source.load(t);
+    const auto visit_tile = [&](const PointRun& visit) { visit(points.xyz); };
+    if (g2s::why_no_surface(points.size(), visit_tile).empty()) return {};
+  }
   const std::string too_wide = why_tile_too_wide(source);
   return too_wide.empty() ? why : too_wide;
 }

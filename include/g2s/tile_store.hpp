@@ -27,10 +27,22 @@ struct TileBox {
   double hi[3] = {0, 0, 0};
 };
 
+// Points that fall in two groups along an axis, with a gap between them this many times wider
+// than either group, are cut apart through the gap whatever their count (docs/tile-store.md,
+// "Adaptive split"): in one float frame (the mesher's) the rounding at the far group would reach
+// about a tenth of the spacing of a million-point tile. So stray points far from a scan (invalid
+// returns left at the origin of georeferenced coordinates) get tiles of their own, and the
+// scan's tiles keep frames near their points.
+inline constexpr double kStrayGap = 1000;
+
 struct TileInfo {
   TileBox box;
   std::uint64_t points = 0;  // points stored in the tile
   double spacing = 0.0;      // estimated mean nearest-neighbour spacing of its points (0 if < 2)
+  // The smallest box holding the tile's points (box for a tile of none), inside box. The tile's
+  // float frame is centred on it: a box stretched by stray points far from the rest would put
+  // the frame's origin far from the tile's points, where float is coarse.
+  TileBox points_box;
 };
 
 struct TileStoreOptions {

@@ -1,8 +1,8 @@
 // The mesher's float frame. Points are meshed in float (the hash grid and the grower store 3
-// floats a point), relative to an origin near a box: a tile's, a seam's tile, or a whole cloud's
-// (origin() says which). The offset is taken in double before rounding, so georeferenced
-// coordinates (around 1e7) keep float's precision. Every stage converts through here, so the same
-// point of the same box gets the same float wherever it is meshed.
+// floats a point), relative to an origin near a box: the box of a tile's points (in the tile and
+// in its seams), or a whole cloud's (origin() says which). The offset is taken in double before
+// rounding, so georeferenced coordinates (around 1e7) keep float's precision. Every stage converts
+// through here, so the same point of the same box gets the same float wherever it is meshed.
 #pragma once
 
 #include <algorithm>
@@ -28,6 +28,15 @@ class LocalFrame {
   Vec3f point(const double* p) const {
     return {static_cast<float>(p[0] - centre_[0]), static_cast<float>(p[1] - centre_[1]),
             static_cast<float>(p[2] - centre_[2])};
+  }
+  // How far the box [lo, hi] reaches from the origin along any axis: float rounds the box's
+  // points in the frame to steps proportional to it.
+  double reach(const double lo[3], const double hi[3]) const {
+    double r = 0;
+    for (int a = 0; a < 3; ++a) {
+      r = std::max({r, std::abs(lo[a] - centre_[a]), std::abs(hi[a] - centre_[a])});
+    }
+    return r;
   }
   // All points of xyz (3 doubles each) in the frame.
   std::vector<float> convert(std::span<const double> xyz) const {

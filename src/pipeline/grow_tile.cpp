@@ -112,7 +112,7 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
       points.xyz.insert(points.xyz.end(), &border.xyz[3 * k], &border.xyz[3 * k + 3]);
     }
   }
-  const std::vector<float> local = LocalFrame(box.lo, box.hi).convert(points.xyz);
+  const std::vector<float> local = tile_frame(tiles[tile]).convert(points.xyz);
   const HashGrid grid(local, points.ids, source.group_distance(), source.twin_distance());
   out.report.points = own;
   out.report.spacing = grid.spacing();

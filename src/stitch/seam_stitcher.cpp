@@ -73,8 +73,8 @@ class SeamStitcher {
     growable_.clear();
     fillable_.clear();
     local_of_.clear();
-    // Positions in a float frame at the tile's centre.
-    const LocalFrame frame(box.lo, box.hi);
+    // Positions in the tile's float frame, as in the tile's own growth.
+    const LocalFrame frame = tile_frame(tiles[tile]);
     // Returns the point's place in ids_. `seam` is the point's distance from the seam, or more
     // than the context for a point of a later tile.
     auto take = [&](Index id, double seam, const double* p) {

@@ -7,6 +7,7 @@
 
 #include "g2s/error.hpp"
 #include "g2s/tile_store.hpp"
+#include "tiling/tile_geometry.hpp"
 #include "tiling/tile_spacing.hpp"
 #include "tiling/tile_split.hpp"
 
@@ -63,7 +64,7 @@ MemoryTiles::MemoryTiles(const PointCloud& cloud, std::uint64_t tile_points) : c
   std::vector<std::uint32_t> tile_of_node(tree.node_count(), kNoIndex);
   for (std::uint32_t t = 0; t < leaves.size(); ++t) {
     tile_of_node[leaves[t]] = t;
-    info_.push_back({tree.box(leaves[t]), 0, 0.0});
+    info_.push_back({tree.box(leaves[t]), 0, 0.0, tree.box(leaves[t])});
   }
   std::vector<std::vector<Index>> members(leaves.size());
   for (Index i = 0; i < cloud.size(); ++i) {
@@ -82,7 +83,7 @@ MemoryTiles::MemoryTiles(const PointCloud& cloud, std::vector<TileBox> boxes) : 
     if (owner == boxes.size()) throw Error(Exit::failure, "MemoryTiles: boxes miss a point");
     members[owner].push_back(i);
   }
-  for (const TileBox& box : boxes) info_.push_back({box, 0, 0.0});
+  for (const TileBox& box : boxes) info_.push_back({box, 0, 0.0, box});
   finish(std::move(members), bounds);
 }
 
@@ -93,6 +94,7 @@ void MemoryTiles::finish(std::vector<std::vector<Index>> members, const TileBox&
   tbb::parallel_for(std::size_t{0}, info_.size(), [&](std::size_t t) {
     info_[t].points = members_[t].size();
     const TilePoints points = load(t);
+    info_[t].points_box = points_box(points.xyz, info_[t].box);
     tiles[t] =
         tiling::measure_tile_spacing(points.xyz, points.ids, info_[t].box, bounds, cloud_.size());
     info_[t].spacing = tiles[t].mean;

@@ -18,8 +18,9 @@ namespace g2s::tiling {
 
 inline constexpr char kMagic[8] = {'G', '2', 'S', 'T', 'I', 'L', 'E', 'S'};
 // 1: no origin; 2: the input's identity and the tiling options (StoreOrigin) in the header;
-// 3: the cloud's spacing in the header; 4: its group and twin distances.
-inline constexpr std::uint32_t kVersion = 4;
+// 3: the cloud's spacing in the header; 4: its group and twin distances; 5: each tile's points'
+// box in its entry.
+inline constexpr std::uint32_t kVersion = 5;
 inline constexpr std::uint32_t kFlagCompressed = 1;
 // Points per frame, the unit of compression and of checksums: load_border reads whole frames.
 inline constexpr std::uint32_t kFramePoints = 16384;
@@ -65,8 +66,9 @@ inline constexpr std::size_t spacing = 56;               // f64
 inline constexpr std::size_t block_offset = 64;          // u64, from the start of the file
 inline constexpr std::size_t block_bytes = 72;           // u64
 inline constexpr std::size_t frame_table_checksum = 80;  // u64, XXH64 of the block's frame table
+inline constexpr std::size_t points_box = 88;            // f64 lo[3], hi[3]
 }  // namespace entry
-inline constexpr std::size_t kEntryBytes = 96;
+inline constexpr std::size_t kEntryBytes = 136;
 
 // Frame table entry fields (the frame table opens each block).
 namespace frame {

@@ -183,6 +183,16 @@ void TileStore::Impl::read_table(const unsigned char* table, std::uint64_t first
              info.box.hi[a], a);
       }
     }
+    for (int a = 0; a < 3; ++a) {
+      info.points_box.lo[a] = load_le<double>(e + entry::points_box + 8 * a);
+      info.points_box.hi[a] = load_le<double>(e + entry::points_box + 24 + 8 * a);
+      if (!(info.box.lo[a] <= info.points_box.lo[a] &&
+            info.points_box.lo[a] <= info.points_box.hi[a] &&
+            info.points_box.hi[a] <= info.box.hi[a])) {
+        fail("tile {}: its points' box [{}, {}] on axis {} is not inside its box", t,
+             info.points_box.lo[a], info.points_box.hi[a], a);
+      }
+    }
     info.points = load_le<std::uint64_t>(e + entry::points);
     info.spacing = load_le<double>(e + entry::spacing);
     block_offset[t] = load_le<std::uint64_t>(e + entry::block_offset);

@@ -31,6 +31,7 @@
 #include "io/readers.hpp"
 #include "io/write_behind.hpp"
 #include "tiling/store_format.hpp"
+#include "tiling/tile_geometry.hpp"
 #include "tiling/tile_spacing.hpp"
 #include "tiling/tile_split.hpp"
 #include "tiling/xxhash64.hpp"
@@ -431,13 +432,19 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
     bounds.hi[a] = -std::numeric_limits<double>::infinity();
   }
   PointSample sample(kSampleTarget);
+  double extreme[6][3] = {};  // the first point to reach each bound: lo x, hi x, lo y, ...
   const ReadReport first = for_each_point(input, [&](const double* p, std::uint64_t id) {
     for (int a = 0; a < 3; ++a) {
+      if (p[a] < bounds.lo[a]) std::copy_n(p, 3, extreme[2 * a]);
+      if (p[a] > bounds.hi[a]) std::copy_n(p, 3, extreme[2 * a + 1]);
       bounds.lo[a] = std::min(bounds.lo[a], p[a]);
       bounds.hi[a] = std::max(bounds.hi[a], p[a]);
     }
     sample.add(p, id);
   });
+  if (!sample.holds_every_point()) {
+    for (const double* p : extreme) sample.add_always(p);
+  }
   if (first.points > kNoIndex) {
     throw Error(Exit::bad_input,
                 fmt::format("{}: {} points; the tile store numbers points with 32 bits (at most "
@@ -545,9 +552,12 @@ TileStoreReport build_tile_store(const std::filesystem::path& input,
           write_block(file, tile_xyz, std::span<const Index>(ids.get() + begin, n), tree.box(node),
                       bounds, options, scratch);
       unsigned char* e = table.data() + t * kEntryBytes;
+      const TileBox own = points_box(tile_xyz, tree.box(node));
       for (int a = 0; a < 3; ++a) {
         store_le(e + entry::box + 8 * a, tree.box(node).lo[a]);
         store_le(e + entry::box + 24 + 8 * a, tree.box(node).hi[a]);
+        store_le(e + entry::points_box + 8 * a, own.lo[a]);
+        store_le(e + entry::points_box + 24 + 8 * a, own.hi[a]);
       }
       store_le(e + entry::points, std::uint64_t{n});
       store_le(e + entry::spacing, spacing[t - round_begin].mean);

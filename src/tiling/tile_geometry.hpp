@@ -9,6 +9,7 @@
 #include <span>
 #include <vector>
 
+#include "common/local_frame.hpp"
 #include "g2s/tile_store.hpp"
 
 namespace g2s {
@@ -20,6 +21,31 @@ inline double box_distance(const TileBox& box, const double* p) {
     d2 += gap * gap;
   }
   return std::sqrt(d2);
+}
+
+// The float frame a tile is meshed in, in the tile and in its seams: on its box, unless that box
+// reaches so far beyond the tile's points (a cut stretched by stray points far from the rest)
+// that a frame on the points' box holds them at least 16 times finer. Short of that, the two
+// frames differ only in how ties between points round, and the box's is kept.
+inline LocalFrame tile_frame(const TileInfo& tile) {
+  const TileBox& own = tile.points_box;
+  const LocalFrame on_box(tile.box.lo, tile.box.hi);
+  const LocalFrame on_points(own.lo, own.hi);
+  return 16 * on_points.reach(own.lo, own.hi) <= on_box.reach(own.lo, own.hi) ? on_points : on_box;
+}
+
+// The smallest box holding the points xyz (3 doubles each), or `empty` when there are none.
+inline TileBox points_box(std::span<const double> xyz, const TileBox& empty) {
+  if (xyz.size() < 3) return empty;
+  TileBox b;
+  for (int a = 0; a < 3; ++a) b.lo[a] = b.hi[a] = xyz[a];
+  for (std::size_t i = 3; i + 2 < xyz.size(); i += 3) {
+    for (int a = 0; a < 3; ++a) {
+      b.lo[a] = std::min(b.lo[a], xyz[i + a]);
+      b.hi[a] = std::max(b.hi[a], xyz[i + a]);
+    }
+  }
+  return b;
 }
 
 inline double box_gap(const TileBox& a, const TileBox& b) {

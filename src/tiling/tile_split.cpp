@@ -63,6 +63,48 @@ bool cut_along(const PointSample& sample, std::uint32_t* begin, std::uint32_t* e
   return true;
 }
 
+// The cut through a stray gap (kStrayGap, g2s/tile_store.hpp) of the points [begin, end), if any:
+// along the axis of the widest such gap, halfway across it. One pass: both groups lie within
+// 1/kStrayGap of the extent from its ends.
+bool stray_cut(const PointSample& sample, const std::uint32_t* begin, const std::uint32_t* end,
+               int& axis, double& cut) {
+  double lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) lo[a] = hi[a] = sample.point(*begin)[a];
+  for (const std::uint32_t* i = begin; i != end; ++i) {
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], sample.point(*i)[a]);
+      hi[a] = std::max(hi[a], sample.point(*i)[a]);
+    }
+  }
+  double widest_gap = 0;
+  for (int a = 0; a < 3; ++a) {
+    const double band = (hi[a] - lo[a]) / kStrayGap;
+    if (!(band > 0)) continue;
+    double low_top = lo[a], high_bottom = hi[a];  // the low group's top, the high group's bottom
+    bool two_groups = true;
+    for (const std::uint32_t* i = begin; i != end && two_groups; ++i) {
+      const double c = sample.point(*i)[a];
+      if (c - lo[a] <= band) {
+        low_top = std::max(low_top, c);
+      } else if (hi[a] - c <= band) {
+        high_bottom = std::min(high_bottom, c);
+      } else {
+        two_groups = false;
+      }
+    }
+    // One group must have a width: a few lone points (a tetrahedron's corners) are no scan.
+    const double group = std::max(low_top - lo[a], hi[a] - high_bottom);
+    const double gap = high_bottom - low_top;
+    if (!two_groups || !(group > 0) || !(gap > kStrayGap * group)) continue;
+    if (gap > widest_gap) {
+      widest_gap = gap;
+      axis = a;
+      cut = 0.5 * (low_top + high_bottom);
+    }
+  }
+  return widest_gap > 0;
+}
+
 }  // namespace
 
 void PointSample::shrink() {
@@ -90,7 +132,11 @@ bool TileTree::split(std::uint32_t node, const PointSample& sample, double weigh
 void TileTree::split_range(std::uint32_t node, const PointSample& sample, std::uint32_t* begin,
                            std::uint32_t* end, double weight, double target) {
   const double estimate = static_cast<double>(end - begin) * weight;
-  if (end - begin < 2 || estimate <= target) return;  // one point cannot be split
+  if (end - begin < 2) return;  // one point cannot be split
+  int stray_axis = 0;
+  double stray_at = 0;
+  const bool stray = stray_cut(sample, begin, end, stray_axis, stray_at);
+  if (!stray && estimate <= target) return;
   // A quantile cut gives the lower side floor(k/2) of the k tiles the points need, so that
   // tiles come out nearly full rather than between half and all of the budget.
   const double pieces = std::ceil(estimate / target);
@@ -115,10 +161,11 @@ void TileTree::split_range(std::uint32_t node, const PointSample& sample, std::u
   // through sloping terrain) has many more of them than its length says. Ties keep the longest
   // side of the box.
   const double near = widest * kSeamWidthShare;
-  int best_axis = -1;
-  double best_cut = 0;
+  int best_axis = stray ? stray_axis : -1;
+  double best_cut = stray_at;
   std::pair<bool, std::ptrdiff_t> best_score;  // (too narrow, points near the cut)
   for (const int axis : axes) {
+    if (stray) break;
     double cut = 0;
     if (!cut_along(sample, begin, end, box, axis, lower_share, cut)) continue;
     const auto close = std::count_if(

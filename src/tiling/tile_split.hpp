@@ -35,6 +35,13 @@ class PointSample {
     hashes_.push_back(h);
     if (hashes_.size() > 2 * target_) shrink();
   }
+  // Holds p whatever its hash, through every later shrink: the points that set the bounds, so
+  // that a stray point far from the rest is seen by the split (kStrayGap) even where the sample
+  // would miss it. Only for a sample that does not hold every point (which has them already).
+  void add_always(const double* p) {
+    xyz_.insert(xyz_.end(), p, p + 3);
+    hashes_.push_back(0);
+  }
   // True while every point offered is held (the threshold was never lowered).
   bool holds_every_point() const { return threshold_ == ~std::uint64_t{0}; }
   std::size_t size() const { return hashes_.size(); }

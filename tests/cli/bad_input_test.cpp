@@ -355,15 +355,23 @@ TEST_F(BadInput, GeoreferencedCoordinatesToStlWarnAboutFloatRounding) {
 
 // A stray point at the origin of a georeferenced scan makes the mesher's float frame too coarse
 // for the scan's detail: the run says so.
-TEST_F(BadInput, GeoreferencedScanWithAStrayPointAtTheOriginWarns) {
-  std::string text = "0 0 0\n";
+// A stray point at the origin of a georeferenced scan gets a tile of its own (kStrayGap): the
+// scan is meshed in float frames near its points, as it is alone, with no warning. (It used to
+// stretch the one tile's frame to the origin, with a warning that points would merge.)
+TEST_F(BadInput, GeoreferencedScanWithAStrayPointAtTheOriginMeshesAsAlone) {
+  std::string text;
   for (int i = 0; i < 80; ++i) {
     for (int j = 0; j < 80; ++j)
-      text += fmt::format("{} {} 250\n", 1.0e7 + 0.25 * i, 5.0e6 + 0.25 * j);
+      text += fmt::format("{} {} {}\n", 1.0e7 + 0.25 * i, 5.0e6 + 0.25 * j, 250 + 0.01 * (i % 3));
   }
-  const CliRun r = mesh(write("stray.xyz", text), out());
-  EXPECT_NE(r.err.find("warning: "), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("a stray point far from the rest?"), std::string::npos) << r.err;
+  const fs::path alone_mesh = dir_ / "alone.ply";
+  const CliRun alone = mesh(write("alone.xyz", text), alone_mesh, {"--json"});
+  ASSERT_EQ(alone.code, kOk) << alone.err;
+  const CliRun r = mesh(write("stray.xyz", "0 0 0\n" + text), out(), {"--json"});
+  ASSERT_EQ(r.code, kOk) << r.err;
+  EXPECT_EQ(r.err.find("warning: "), std::string::npos) << r.err;
+  EXPECT_EQ(json_number(r.out, "duplicates_merged"), 0.0) << r.out;
+  EXPECT_EQ(json_number(r.out, "triangles"), json_number(alone.out, "triangles"));
 }
 
 // Exact duplicates are merged: the mesh is the one of the distinct points, byte for byte.
