@@ -139,9 +139,6 @@ void run_mesh(MeshArgs& args) {
           const PipelineSummary summary = mesh_tiles(store, args.options, sink);
           progress.clear();
           if (!args.out.quiet && summary.triangles > 0) {
-            if (const std::string why = why_tile_too_wide(store); !why.empty()) {
-              fmt::print(stderr, "g2s: warning: {}: {}\n", args.input, why);
-            }
             if (summary.report.duplicates_merged > 0 && store.twin_distance() > 0) {
               fmt::print(stderr,
                          "g2s: note: {}: {} duplicate points and near-copies merged (most points "

@@ -82,8 +82,6 @@ void warn_if_stl_rounds(const std::string& output, const MeshStreamWriter& write
   }
 }
 
-}  // namespace
-
 // Points farther from their tile's centre than float resolves at the tile's spacing: the mesher
 // (float around each tile's centre) merges them. A reason, or "".
 std::string why_tile_too_wide(const TileSource& source) {
@@ -103,16 +101,14 @@ std::string why_tile_too_wide(const TileSource& source) {
   return "";
 }
 
-namespace {
-
-// Why the points of `source` cannot form a surface (none, one point, two, a line), or "". A
-// tile too wide for float precision is named first: it is the true reason then. Sets
+// Why the points of `source` cannot form a surface (none, one point, two, a line, a tile too wide
+// for float precision), or "". Sets
 // `all_float` to whether every coordinate is exactly a float, read on the check's first pass
 // over the points (a pass the check makes anyway).
 std::string why_no_surface(const TileSource& source, bool& all_float) {
   all_float = true;
   bool first_pass = true;
-  const std::string why = g2s::why_no_surface(source.point_count(), [&](const PointRun& visit) {
+  std::string why = g2s::why_no_surface(source.point_count(), [&](const PointRun& visit) {
     for (std::size_t t = 0; t < source.tiles().size(); ++t) {
       const TilePoints points = source.load(t);
       if (first_pass) {
@@ -124,11 +120,15 @@ std::string why_no_surface(const TileSource& source, bool& all_float) {
     }
     first_pass = false;
   });
+  // A tile the mesher's float frame cannot resolve (stray points scattered so that the split
+  // could not cut them off) would merge its points and those its seams load: refused, whatever
+  // the rest makes.
+  if (std::string too_wide = why_tile_too_wide(source); !too_wide.empty()) return too_wide;
   if (why.empty()) return {};
   // Stray points far from the rest stretch the extent the check measures collinearity against
-  // (a millionth of it); the tiles keep them apart (kStrayGap), and each tile is meshed in a
-  // float frame of its own. So a tile far narrower than the cloud whose own points make a
-  // surface is enough.
+  // (a millionth of it); where the tiles have kept them apart (kStrayGap, no tile left too wide
+  // for float), each tile is meshed in a float frame of its own. So a tile far narrower than the
+  // cloud whose own points make a surface is enough.
   const auto widest = [](const TileBox& box) {
     return std::max({box.hi[0] - box.lo[0], box.hi[1] - box.lo[1], box.hi[2] - box.lo[2]});
   };
@@ -149,8 +149,7 @@ std::string why_no_surface(const TileSource& source, bool& all_float) {
     const auto visit_tile = [&](const PointRun& visit) { visit(points.xyz); };
     if (g2s::why_no_surface(points.size(), visit_tile).empty()) return {};
   }
-  const std::string too_wide = why_tile_too_wide(source);
-  return too_wide.empty() ? why : too_wide;
+  return why;
 }
 
 [[noreturn]] void throw_no_surface(const std::string& why, const RunFacts& facts) {

@@ -44,8 +44,4 @@ void write_and_report(const TileSource& source,
                       const std::function<PipelineSummary(MeshSink&)>& run, const OutputArgs& args,
                       const RunFacts& facts);
 
-// Why a tile's points are too far from its centre for the mesher's float coordinates at the
-// tile's spacing (a stray point far from the rest stretches its tile), or "".
-std::string why_tile_too_wide(const TileSource& source);
-
 }  // namespace g2s::cli

@@ -73,8 +73,8 @@ class SeamStitcher {
     growable_.clear();
     fillable_.clear();
     local_of_.clear();
-    // Positions in the tile's float frame, as in the tile's own growth.
-    const LocalFrame frame = tile_frame(tiles[tile]);
+    // Positions are taken in double and put in a float frame once all are known (below).
+    seam_xyz_.clear();
     // Returns the point's place in ids_. `seam` is the point's distance from the seam, or more
     // than the context for a point of a later tile.
     auto take = [&](Index id, double seam, const double* p) {
@@ -94,7 +94,7 @@ class SeamStitcher {
       ids_.push_back(id);
       growable_.push_back(whole && seam <= band);
       fillable_.push_back(whole);
-      frame.append(p, local_);
+      seam_xyz_.insert(seam_xyz_.end(), p, p + 3);
       return at;
     };
     const double later = reach.context + 1;  // a later tile's points are context only
@@ -120,14 +120,13 @@ class SeamStitcher {
     preload_.clear();
     preload_group_.clear();
     preload_live_.clear();
-    context_corners_.clear();
+    context_slots_.clear();
     for (std::size_t t = 0; t < live.triangles.size(); ++t) {
       const Triangle& tri = live.triangles[t];
       const std::uint8_t touches = live.flags[tri[0]] | live.flags[tri[1]] | live.flags[tri[2]];
       if (!(touches & LiveMesh::kStarLoaded)) {
         if (touches & LiveMesh::kInContext) {
-          for (const Index s : tri)
-            context_corners_.push_back(frame.point(&live.xyz[3 * std::size_t{s}]));
+          context_slots_.insert(context_slots_.end(), tri.begin(), tri.end());
         }
         continue;
       }
@@ -146,6 +145,15 @@ class SeamStitcher {
       const std::uint32_t s = live.slot(id);
       if (s != IdMap::kMissing) live.flags[s] &= ~(LiveMesh::kStarLoaded | LiveMesh::kInContext);
     }
+    // The tile's float frame, as in its own growth, unless the seam's points lie far from it (a
+    // tile stretched by a stray point it could not be cut from): then one on their own box, so
+    // that corners kept apart in their tiles' frames stay apart here.
+    const LocalFrame frame = finer_frame(tile_frame(tiles[tile]), points_box(seam_xyz_, box));
+    local_ = frame.convert(seam_xyz_);
+    context_corners_.clear();
+    for (const Index s : context_slots_) {
+      context_corners_.push_back(frame.point(&live.xyz[3 * std::size_t{s}]));
+    }
 
     // Kept corners stay in the grid in a cloud of twins: a seam's float frame may judge a pair at
     // the twin distance otherwise than the tile's did.
@@ -158,14 +166,19 @@ class SeamStitcher {
     }
     const HashGrid grid(local_, ids_, source_.group_distance(), source_.twin_distance(), corner);
     // Place in ids_ -> grid index, for the preloaded corners (the grid keeps the smallest id of
-    // exact duplicates, as every tile's grid does, so all kept corners are in it).
+    // exact duplicates, as every tile's grid does, so all kept corners are in it, unless two of
+    // them round to one float here: a seam whose points lie too far apart for float, as where
+    // stray points scattered far from a scan stretch a tile no cut could free them from).
     grid_of_.assign(ids_.size(), kNoIndex);
     for (std::uint32_t k = 0; k < grid.size(); ++k) grid_of_[grid.source(k)] = k;
     for (Triangle& t : preload_) {
       for (Index& v : t) {
         v = grid_of_[v];
         if (v == kNoIndex) {
-          throw Error(Exit::failure, "seam stitcher: a kept corner is missing from the seam grid");
+          throw Error(Exit::no_surface,
+                      "no surface can be formed: the points of a seam lie too far apart for the "
+                      "mesher's float coordinates, which merge two of its kept points (stray "
+                      "points far from the rest?); nothing written");
         }
       }
     }
@@ -357,7 +370,9 @@ class SeamStitcher {
   std::vector<Triangle> preload_;
   std::vector<std::uint32_t> preload_group_;
   std::vector<std::uint32_t> preload_live_;  // per preloaded triangle: its place in the live mesh
-  std::vector<Vec3f> context_corners_;       // per live triangle touching only context: its corners
+  std::vector<double> seam_xyz_;             // per point of ids_: its position
+  std::vector<Index> context_slots_;         // per live triangle touching only context: its corners
+  std::vector<Vec3f> context_corners_;       // and their positions in the seam's frame
   // The orientation vote's scratch: per seam grid point, its label and normal.
   std::vector<std::uint32_t> label_;
   std::vector<Vec3> normal_;

@@ -23,15 +23,19 @@ inline double box_distance(const TileBox& box, const double* p) {
   return std::sqrt(d2);
 }
 
-// The float frame a tile is meshed in, in the tile and in its seams: on its box, unless that box
-// reaches so far beyond the tile's points (a cut stretched by stray points far from the rest)
-// that a frame on the points' box holds them at least 16 times finer. Short of that, the two
-// frames differ only in how ties between points round, and the box's is kept.
+// `usual`, unless a frame on the box of the points it is for holds them at least 16 times finer
+// (`usual` stretched toward stray points far from them). Short of that, the two frames differ
+// only in how ties between points round, and `usual` is kept.
+inline LocalFrame finer_frame(const LocalFrame& usual, const TileBox& points) {
+  const LocalFrame on_points(points.lo, points.hi);
+  return 16 * on_points.reach(points.lo, points.hi) <= usual.reach(points.lo, points.hi) ? on_points
+                                                                                         : usual;
+}
+
+// The float frame a tile is meshed in: on its box, or on its points' box where that box reaches
+// far beyond them (finer_frame). Its seams start from it.
 inline LocalFrame tile_frame(const TileInfo& tile) {
-  const TileBox& own = tile.points_box;
-  const LocalFrame on_box(tile.box.lo, tile.box.hi);
-  const LocalFrame on_points(own.lo, own.hi);
-  return 16 * on_points.reach(own.lo, own.hi) <= on_box.reach(own.lo, own.hi) ? on_points : on_box;
+  return finer_frame(LocalFrame(tile.box.lo, tile.box.hi), tile.points_box);
 }
 
 // The smallest box holding the points xyz (3 doubles each), or `empty` when there are none.

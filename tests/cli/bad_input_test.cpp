@@ -353,8 +353,6 @@ TEST_F(BadInput, GeoreferencedCoordinatesToStlWarnAboutFloatRounding) {
   EXPECT_NE(r.err.find("write .ply to keep them exactly"), std::string::npos) << r.err;
 }
 
-// A stray point at the origin of a georeferenced scan makes the mesher's float frame too coarse
-// for the scan's detail: the run says so.
 // A stray point at the origin of a georeferenced scan gets a tile of its own (kStrayGap): the
 // scan is meshed in float frames near its points, as it is alone, with no warning. (It used to
 // stretch the one tile's frame to the origin, with a warning that points would merge.)

@@ -223,6 +223,29 @@ TEST_F(HostileCli, FarStrayPointIsLeftOutOfTheMesh) {
   for (std::size_t v = 0; v < mesh.vertex_count(); ++v) EXPECT_LT(mesh.xyz[3 * v], 4.0);
 }
 
+// Strays scattered over a box far wider than the scan, which no single cut separates from it,
+// leave tiles too wide for the mesher's float frame: refused (exit 5) with that reason, before
+// meshing or where a seam's points merge in float (that seam used to stop on an internal error,
+// exit 1, once tiles had frames of their own).
+TEST_F(HostileCli, ScatteredStrayPointsTooWideForFloatAreRefused) {
+  std::string text;
+  for (int i = 0; i < 200; ++i) {
+    for (int j = 0; j < 200; ++j) {
+      text += fmt::format("{} {} {}\n", 500000.123 + 0.25 * i, 5000000.456 + 0.25 * j,
+                          300 + 0.01 * ((i * j) % 7));
+    }
+  }
+  std::uint64_t state = 12345;  // a fixed sequence spread over [-1e6, 1e7) on each axis
+  const auto next = [&] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return -1e6 + 1.1e7 * static_cast<double>(state >> 11) * 0x1.0p-53;
+  };
+  for (int k = 0; k < 50; ++k) text += fmt::format("{} {} {}\n", next(), next(), next());
+  const CliRun r =
+      run({"mesh", write("scattered.xyz", text).string(), "-o", path("scattered.ply").string()});
+  expect_says(r, kNoSurface, {"float coordinates", "stray point"});
+}
+
 // A plane square to x far from zero (x = 1e15, one value: a double no float equals) meshes as
 // the same plane at x = 0 does, in as little time: the mesher's frame puts it at 0, not up to
 // half a float step (3.4e7) away, where float cannot tell its points apart. At 1e100 too, where
