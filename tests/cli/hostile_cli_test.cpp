@@ -23,6 +23,7 @@
 #include "g2s/io.hpp"
 #include "support/cli.hpp"
 #include "support/temp_folder.hpp"
+#include "support/utm_terrain.hpp"
 #include "tiling/xxhash64.hpp"
 
 namespace {
@@ -228,13 +229,7 @@ TEST_F(HostileCli, FarStrayPointIsLeftOutOfTheMesh) {
 // meshing or where a seam's points merge in float (that seam used to stop on an internal error,
 // exit 1, once tiles had frames of their own).
 TEST_F(HostileCli, ScatteredStrayPointsTooWideForFloatAreRefused) {
-  std::string text;
-  for (int i = 0; i < 200; ++i) {
-    for (int j = 0; j < 200; ++j) {
-      text += fmt::format("{} {} {}\n", 500000.123 + 0.25 * i, 5000000.456 + 0.25 * j,
-                          300 + 0.01 * ((i * j) % 7));
-    }
-  }
+  std::string text = g2s::test_support::utm_terrain_xyz(200);
   std::uint64_t state = 12345;  // a fixed sequence spread over [-1e6, 1e7) on each axis
   const auto next = [&] {
     state = state * 6364136223846793005ull + 1442695040888963407ull;

@@ -38,6 +38,7 @@
 #include "support/cli.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_folder.hpp"
+#include "support/utm_terrain.hpp"
 #include "tiling/store_format.hpp"
 #include "tiling/xxhash64.hpp"
 
@@ -502,13 +503,7 @@ TEST_F(TileStoreTest, StrayPointsFarFromTheRestGetATileOfTheirOwn) {
   // A 100 x 100 grid in UTM-sized coordinates and three points at the origin, a thousand times
   // farther from it than its width (kStrayGap): whatever the tile size, the three get a tile of
   // their own, and no other tile's points reach farther than the grid.
-  std::string text;
-  for (int i = 0; i < 100; ++i) {
-    for (int j = 0; j < 100; ++j) {
-      text += fmt::format("{} {} {}\n", 500000.123 + 0.25 * i, 5000000.456 + 0.25 * j,
-                          300 + 0.01 * ((i * j) % 7));
-    }
-  }
+  const std::string text = g2s::test_support::utm_terrain_xyz(100);
   const fs::path input = write("utm.xyz", text + "0 0 0\n0 0 0\n0 0 0\n");
   const g2s::PointCloud cloud = g2s::read_points(input);
   for (const std::uint64_t budget : {3000u, 1000000u}) {
