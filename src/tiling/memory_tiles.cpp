@@ -14,21 +14,6 @@
 namespace g2s {
 namespace {
 
-TileBox bounding_box(const PointCloud& cloud) {
-  TileBox box;
-  for (int a = 0; a < 3; ++a) {
-    box.lo[a] = cloud.size() ? cloud.xyz[a] : 0.0;
-    box.hi[a] = box.lo[a];
-  }
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    for (int a = 0; a < 3; ++a) {
-      box.lo[a] = std::min(box.lo[a], cloud.xyz[3 * i + a]);
-      box.hi[a] = std::max(box.hi[a], cloud.xyz[3 * i + a]);
-    }
-  }
-  return box;
-}
-
 // Owner of a point among boxes that partition the bounding box: half-open, except on the
 // bounding box's own upper faces.
 bool owns(const TileBox& box, const TileBox& bounds, const double* p) {
@@ -52,7 +37,7 @@ MemoryTiles::MemoryTiles(const PointCloud& cloud, std::uint64_t tile_points) : c
   // The tile store's split, on every point (its exact case).
   tiling::PointSample sample(cloud.size());
   for (std::size_t i = 0; i < cloud.size(); ++i) sample.add(&cloud.xyz[3 * i], i);
-  const TileBox bounds = bounding_box(cloud);
+  const TileBox bounds = points_box(cloud.xyz, TileBox{});
   tiling::TileTree tree(bounds);
   if (cloud.size() > 0) {
     const double budget = static_cast<double>(std::max<std::uint64_t>(tile_points, 1));
@@ -74,7 +59,7 @@ MemoryTiles::MemoryTiles(const PointCloud& cloud, std::uint64_t tile_points) : c
 }
 
 MemoryTiles::MemoryTiles(const PointCloud& cloud, std::vector<TileBox> boxes) : cloud_(cloud) {
-  const TileBox bounds = bounding_box(cloud);
+  const TileBox bounds = points_box(cloud.xyz, TileBox{});
   std::vector<std::vector<Index>> members(boxes.size());
   for (Index i = 0; i < cloud.size(); ++i) {
     const double* p = &cloud.xyz[3 * std::size_t{i}];

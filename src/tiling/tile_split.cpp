@@ -63,19 +63,11 @@ bool cut_along(const PointSample& sample, std::uint32_t* begin, std::uint32_t* e
   return true;
 }
 
-// The cut through a stray gap (kStrayGap, g2s/tile_store.hpp) of the points [begin, end), if any:
-// along the axis of the widest such gap, halfway across it. One pass: both groups lie within
-// 1/kStrayGap of the extent from its ends.
+// The cut through a stray gap (kStrayGap, g2s/tile_store.hpp) of the points [begin, end), whose
+// extent is [lo, hi], if any: along the axis of the widest such gap, halfway across it. One pass
+// an axis: both groups lie within 1/kStrayGap of the extent from its ends.
 bool stray_cut(const PointSample& sample, const std::uint32_t* begin, const std::uint32_t* end,
-               int& axis, double& cut) {
-  double lo[3], hi[3];
-  for (int a = 0; a < 3; ++a) lo[a] = hi[a] = sample.point(*begin)[a];
-  for (const std::uint32_t* i = begin; i != end; ++i) {
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::min(lo[a], sample.point(*i)[a]);
-      hi[a] = std::max(hi[a], sample.point(*i)[a]);
-    }
-  }
+               const double lo[3], const double hi[3], int& axis, double& cut) {
   double widest_gap = 0;
   for (int a = 0; a < 3; ++a) {
     const double band = (hi[a] - lo[a]) / kStrayGap;
@@ -133,9 +125,19 @@ void TileTree::split_range(std::uint32_t node, const PointSample& sample, std::u
                            std::uint32_t* end, double weight, double target) {
   const double estimate = static_cast<double>(end - begin) * weight;
   if (end - begin < 2) return;  // one point cannot be split
+  // The extent of the node's points along each axis.
+  double lo[3], hi[3], extent[3];
+  for (int a = 0; a < 3; ++a) lo[a] = hi[a] = sample.point(*begin)[a];
+  for (const std::uint32_t* i = begin; i != end; ++i) {
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], sample.point(*i)[a]);
+      hi[a] = std::max(hi[a], sample.point(*i)[a]);
+    }
+  }
+  for (int a = 0; a < 3; ++a) extent[a] = hi[a] - lo[a];
   int stray_axis = 0;
   double stray_at = 0;
-  const bool stray = stray_cut(sample, begin, end, stray_axis, stray_at);
+  const bool stray = stray_cut(sample, begin, end, lo, hi, stray_axis, stray_at);
   if (!stray && estimate <= target) return;
   // A quantile cut gives the lower side floor(k/2) of the k tiles the points need, so that
   // tiles come out nearly full rather than between half and all of the budget.
@@ -145,14 +147,6 @@ void TileTree::split_range(std::uint32_t node, const PointSample& sample, std::u
   std::array<int, 3> axes = {0, 1, 2};
   std::stable_sort(axes.begin(), axes.end(),
                    [&](int a, int b) { return box.hi[a] - box.lo[a] > box.hi[b] - box.lo[b]; });
-  // The extent of the node's points along each axis.
-  double extent[3] = {0, 0, 0};
-  for (int a = 0; a < 3; ++a) {
-    const auto [lo, hi] = std::minmax_element(begin, end, [&](std::uint32_t i, std::uint32_t j) {
-      return sample.point(i)[a] < sample.point(j)[a];
-    });
-    extent[a] = sample.point(*hi)[a] - sample.point(*lo)[a];
-  }
   const double widest = *std::max_element(std::begin(extent), std::end(extent));
   // Each axis's cut, then the one with the fewest points near it among the axes along which the
   // points reach at least 2/3 as far as along the widest (so that tiles stay compact and a
