@@ -82,6 +82,31 @@ void warn_if_stl_rounds(const std::string& output, const MeshStreamWriter& write
   }
 }
 
+// More points left out than this share of the cloud get a note. On the shared real scans
+// (airborne lidar, photogrammetry, range and stereo scans) at most 2.7% are; the rest are
+// outliers or a layer's points off its one sheet. Far more means outliers, or a region sampled
+// so much more sparsely than its tile that the search does not reach across it
+// (docs/algorithm.md §8), and the mesh does not show it.
+constexpr double kLeftOutNote = 0.05;
+
+// Notes how many input points are not vertices of the mesh (duplicates merged aside), when they
+// are more than kLeftOutNote of them.
+void note_points_left_out(const std::string& output, const PipelineSummary& summary) {
+  const MeshReport& r = summary.report;
+  const std::uint64_t distinct =
+      r.points > r.duplicates_merged ? r.points - r.duplicates_merged : 0;
+  if (distinct == 0 || summary.vertices >= distinct) return;
+  const std::uint64_t left_out = distinct - summary.vertices;
+  const double share = static_cast<double>(left_out) / static_cast<double>(distinct);
+  if (share <= kLeftOutNote) return;
+  fmt::print(stderr,
+             "g2s: note: {}: {} of the {} distinct points ({:.1f}%) are not vertices of the mesh: "
+             "outliers, or a region sampled far more sparsely than the points around it, which "
+             "the search does not reach (g2s stats --points gives their distances to the mesh; "
+             "smaller tiles, --tile-points, recover part of such a region)\n",
+             output, left_out, distinct, 100.0 * share);
+}
+
 // Points farther from their tile's centre than float resolves at the tile's spacing: the mesher
 // (float around each tile's centre) merges them. A reason, or "".
 std::string why_tile_too_wide(const TileSource& source) {
@@ -263,6 +288,7 @@ void write_and_report(const TileSource& source,
   if (!args.quiet && format != MeshFormat::ply_binary) {
     warn_if_stl_rounds(args.output, writer, summary.report.spacing);
   }
+  if (!args.quiet) note_points_left_out(args.output, summary);
   const MeshReport& r = summary.report;
   const std::uint64_t triangles = summary.triangles;
   // The summary: counted in stride, or (should that count not be exact) read back when that

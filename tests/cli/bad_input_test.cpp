@@ -387,6 +387,38 @@ TEST_F(BadInput, DuplicatePointsAreMerged) {
   EXPECT_TRUE(file_bytes(out()) == file_bytes(distinct_mesh)) << "duplicates changed the mesh";
 }
 
+// A dense patch inside a square sampled 16 times more sparsely: the search, sized by the
+// patch's spacing, does not reach across the square, whose points are left out. The mesh
+// cannot show that, so a note counts them (exactly the points that are not vertices); a clean
+// patch, all of whose points are vertices, gets none.
+TEST_F(BadInput, PointsLeftOutOfTheMeshAreNoted) {
+  std::vector<Point> points;
+  for (int i = 0; i < 40; ++i) {
+    for (int j = 0; j < 40; ++j) {
+      if (i >= 16 && i < 24 && j >= 16 && j < 24) continue;  // the patch's place
+      points.push_back({i * 0.25, j * 0.25, 0.1 * std::sin(i * 0.25)});
+    }
+  }
+  for (int i = 0; i < 128; ++i) {
+    for (int j = 0; j < 128; ++j) {
+      const double x = 4 + i * (2.0 / 128), y = 4 + j * (2.0 / 128);
+      points.push_back({x, y, 0.1 * std::sin(x)});
+    }
+  }
+  const CliRun r = mesh(write("patch.xyz", xyz_text(points)), out(), {"--json"});
+  ASSERT_EQ(r.code, kOk) << r.err;
+  const double distinct = json_number(r.out, "points") - json_number(r.out, "duplicates_merged");
+  const double left_out = distinct - json_number(r.out, "vertices");
+  ASSERT_GT(left_out, 0.05 * distinct) << r.out;  // most of the sparse square's 1,536 points
+  EXPECT_NE(r.err.find(fmt::format("{} of the {} distinct points", left_out, distinct)),
+            std::string::npos)
+      << r.err;
+
+  const CliRun clean = mesh(write("clean.xyz", xyz_text(wavy_patch())), out(), {"--json"});
+  ASSERT_EQ(clean.code, kOk) << clean.err;
+  EXPECT_EQ(clean.err.find("not vertices of the mesh"), std::string::npos) << clean.err;
+}
+
 TEST_F(BadInput, DirectoryAsInput) {
   const fs::path folder = dir_ / "scans.ply";
   fs::create_directory(folder);
