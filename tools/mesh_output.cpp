@@ -83,8 +83,8 @@ void warn_if_stl_rounds(const std::string& output, const MeshStreamWriter& write
 }
 
 // More points left out than this share of the cloud get a note. On the shared real scans
-// (airborne lidar, photogrammetry, range and stereo scans) at most 2.7% are, outliers and a
-// layer's points off its one sheet. Far more means many outliers, or a region sampled so much
+// (airborne lidar, photogrammetry, range and stereo scans) at most 2.3% are (4_6_crop), outliers
+// and a layer's points off its one sheet. Far more means many outliers, or a region sampled so much
 // more sparsely than its tile that the search does not reach across it (docs/algorithm.md §8),
 // and the mesh does not show it.
 constexpr double kLeftOutNote = 0.05;
