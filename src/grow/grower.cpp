@@ -683,7 +683,9 @@ class Grower {
   // A hole that cannot be filled so (most often because the surface around it folds over it) is
   // widened ring by ring (widen) and filled in place of the rings, if it then can be and the
   // points that leaves out lie close to the surface (leaves_out_only_near); a loop through a
-  // point with several open fans (a gap between them) only with widen_fan_gaps. Only holes with
+  // point with several open fans (a gap between them) only with widen_fan_gaps. A hole whose
+  // rings gave up is widened once more by the ring across its edges and the triangles of its
+  // corners' fans folded over it, if a survey finds only such (survey_crossings). Only holes with
   // a point set in `only` are tried, unless it is empty. Appends the filling triangles to
   // triangles_ and marks the rings kUnlinked in `dead` (sized as triangles_). Returns whether a
   // hole gave up because its widening reached a filling of this round, and sets `retry` (sized
@@ -805,11 +807,14 @@ class Grower {
                       [&](std::uint32_t e) { return dead[open[e].triangle] != 0; })) {
         continue;
       }
-      attempt.clear();
-      attempt.merged.push_back(i);
-      for (const std::uint32_t e : edges) {
-        attempt.add_edge(open[e].from, open[e].triangle, facing_normal(open[e].triangle));
-      }
+      const auto start_attempt = [&] {
+        attempt.clear();
+        attempt.merged.push_back(i);
+        for (const std::uint32_t e : edges) {
+          attempt.add_edge(open[e].from, open[e].triangle, facing_normal(open[e].triangle));
+        }
+      };
+      start_attempt();
       if (!cells) cells.emplace(grid_.points(), std::span<const Triangle>(triangles_));
       bool done = try_fill(*cells, attempt, scratch, fill);
       const auto through_fan_gap = [&] {
@@ -823,6 +828,20 @@ class Grower {
         if (widening != Widening::widened) break;
         done =
             try_fill(*cells, attempt, scratch, fill) && leaves_out_only_near(attempt, fill, dead);
+      }
+      // Still open: where every triangle that crosses the first filling's candidates is of a
+      // loop point's fan, and not all are across the loop's edges (a fold over the hole), they
+      // are taken off with just the ring across the loop's edges, and the hole filled in their
+      // place.
+      if (!done && widens && max_rings > 0 && widening != Widening::met_filling) {
+        start_attempt();
+        try_fill(*cells, attempt, scratch, fill, /*survey=*/true);
+        if (folded_over(attempt)) {
+          done = widen(*cells, attempt, holes, dead, widened_edges(max_edges, 1), folded_over_) ==
+                     Widening::widened &&
+                 try_fill(*cells, attempt, scratch, fill) &&
+                 leaves_out_only_near(attempt, fill, dead);
+        }
       }
       if (!done) {
         if (widening == Widening::met_filling) {
@@ -961,8 +980,13 @@ class Grower {
   }
 
   // Triangulates the attempt's loop (triangulate_loop) into `fill`, if it can be.
+  // With `survey`, the triangles asked about are held to survey_crossings instead.
   bool try_fill(const detail::TriangleCells& cells, const Attempt& attempt,
-                detail::HoleScratch& scratch, std::vector<Triangle>& fill) {
+                detail::HoleScratch& scratch, std::vector<Triangle>& fill, bool survey = false) {
+    if (survey) {
+      folded_over_.clear();
+      off_the_fans_ = false;
+    }
     // The filling traverses each loop edge the other way: the loop reversed, so that edge i
     // of the reversed loop is edge n-2-i of the loop, and the closing edge stays last.
     loop_.assign(attempt.loop.rbegin(), attempt.loop.rend());
@@ -982,7 +1006,8 @@ class Grower {
     for (const Index v : loop_) loop_box = detail::enclose(loop_box, grid_.point(v));
     gather_near(cells, loop_box, [&](std::uint32_t other) { return attempt.in_ring(other); });
     const auto triangle_ok = [&](std::size_t i, std::size_t k, std::size_t j) {
-      return fill_fits({loop_[i], loop_[k], loop_[j]});
+      return survey ? !survey_crossings({loop_[i], loop_[k], loop_[j]})
+                    : fill_fits({loop_[i], loop_[k], loop_[j]});
     };
     return detail::triangulate_loop(grid_.points(), loop_, around_, chord_ok, triangle_ok, scratch,
                                     fill)
@@ -1001,9 +1026,11 @@ class Grower {
   // crossing test until the round ends (met_filling).
   enum class Widening { widened, stopped, met_filling };
   Widening widen(const detail::TriangleCells& cells, Attempt& attempt, const HoleIndex& holes,
-                 const std::vector<std::uint8_t>& dead, std::size_t max_edges) {
+                 const std::vector<std::uint8_t>& dead, std::size_t max_edges,
+                 std::span<const std::uint32_t> also = {}) {
     std::vector<std::uint32_t>& ring = attempt.ring;
     ring.insert(ring.end(), attempt.outside.begin(), attempt.outside.end());
+    ring.insert(ring.end(), also.begin(), also.end());
     const std::size_t merged_before = attempt.merged.size();
     std::vector<Border>& border = border_;
     // The border edge leaving point v (border sorted by `from`, each point once), or
@@ -1276,6 +1303,44 @@ class Grower {
       }
     }
     return true;
+  }
+
+  // A survey of what refuses a hole's first filling: lists in folded_over_ every triangle near
+  // the loop (loop_near_) that triangle t crosses, and returns whether there is one. Once such a
+  // triangle has no corner on the loop (loop_), the hole is not under a fold of its corners'
+  // fans: off_the_fans_ is set, and every later triangle is refused unasked, so that the survey
+  // ends soon (a loop edge with no triangle left ends it).
+  bool survey_crossings(const Triangle& t) {
+    if (off_the_fans_) return true;
+    const detail::Box box = detail::box_of(grid_.points(), t);
+    const SeparatingPlanes planes(grid_.points(), t);
+    const std::size_t before = folded_over_.size();
+    for (const NearTriangle& near : loop_near_) {
+      const Triangle& other = triangles_[near.index];
+      if (!detail::overlap(box, near.box) || planes.separate(grid_.points(), other) ||
+          !detail::triangles_cross(grid_.points(), t, other)) {
+        continue;
+      }
+      if (std::none_of(other.begin(), other.end(), [&](Index v) {
+            return std::find(loop_.begin(), loop_.end(), v) != loop_.end();
+          })) {
+        off_the_fans_ = true;
+        return true;
+      }
+      folded_over_.push_back(near.index);
+    }
+    return folded_over_.size() > before;
+  }
+
+  // Whether the survey found the hole under a fold: every triangle that crosses a candidate of
+  // its first filling (folded_over_) is of a loop point's fan, and not all are across the loop's
+  // edges. Sorts and dedups them.
+  bool folded_over(const Attempt& attempt) {
+    std::sort(folded_over_.begin(), folded_over_.end());
+    folded_over_.erase(std::unique(folded_over_.begin(), folded_over_.end()), folded_over_.end());
+    return !off_the_fans_ && !std::all_of(folded_over_.begin(), folded_over_.end(), [&](auto t) {
+      return std::find(attempt.outside.begin(), attempt.outside.end(), t) != attempt.outside.end();
+    });
   }
 
   // Fillings of neighbouring holes may cross each other: the later filling of each crossing
@@ -1664,8 +1729,10 @@ class Grower {
     detail::Box box;
   };
   std::vector<NearTriangle> loop_near_;
-  std::uint32_t last_blocker_ = kNoIndex;  // fill_fits: the place in loop_near_ that refused last
-  std::vector<std::uint32_t> near_hits_;   // fill_fits: places in loop_near_ whose boxes overlap
+  std::vector<std::uint32_t> folded_over_;  // survey_crossings: what crosses a hole's first filling
+  bool off_the_fans_ = false;               // and whether one of them is of no loop point's fan
+  std::uint32_t last_blocker_ = kNoIndex;   // fill_fits: the place in loop_near_ that refused last
+  std::vector<std::uint32_t> near_hits_;    // fill_fits: places in loop_near_ whose boxes overlap
   // An edge of a widened hole's border, as the triangle outside it faces (outside, once found).
   struct Border {
     Index from, to;

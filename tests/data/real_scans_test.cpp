@@ -10,6 +10,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <ostream>
+#include <set>
+#include <span>
 #include <string>
 
 #include "g2s/io.hpp"
@@ -152,6 +154,48 @@ TEST(RealScanGaps, WideningHolesLeavesFewerHolesAndOnlyPointsNearTheSurfaceOut) 
   }
 }
 
+// A pinhole of raw-bunny that the surface folds over: triangles of its corners' fans lie over
+// the hole, so every filling crosses one, and widening ring by ring meets more folds before the
+// hole closes. The narrow widening (the ring across the loop's edges and the folded triangles;
+// docs/algorithm.md, "Hole filling") fills it. The points within 15 mm of it, meshed as g2s mesh
+// meshes them: no open edge within 6 mm (without the narrow widening, 9 open edges stay there)
+// and no defect. The crop holds the fold as growth makes it now; a change to growth may move it,
+// and then another pinhole the narrow widening closes serves (bench/results/2026-12-07-session40.md
+// tells how this one was found).
+TEST(RealScanGaps, APinholeUnderAFoldIsFilled) {
+  const std::filesystem::path path = data_dir() / "raw-bunny.ply";
+  G2S_SKIP_WITHOUT_DATA(path);
+  const g2s::PointCloud cloud = g2s::read_points(path);
+  const double centre[3] = {0.020481444444444444, 0.121161, -0.006624222222222222};
+  const auto distance2 = [&](std::span<const double> xyz, std::size_t i) {
+    double d2 = 0;
+    for (int k = 0; k < 3; ++k) d2 += (xyz[3 * i + k] - centre[k]) * (xyz[3 * i + k] - centre[k]);
+    return d2;
+  };
+  g2s::PointCloud crop;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (distance2(cloud.xyz, i) < 0.015 * 0.015) {
+      crop.xyz.insert(crop.xyz.end(), cloud.xyz.begin() + 3 * i, cloud.xyz.begin() + 3 * i + 3);
+    }
+  }
+  ASSERT_EQ(crop.size(), 6021u);
+  g2s::PipelineMesh mesh = g2s::mesh_cloud(crop);
+  std::set<std::pair<g2s::Index, g2s::Index>> edges;
+  for (const g2s::Triangle& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) edges.insert({t[k], t[(k + 1) % 3]});
+  }
+  std::size_t open_near = 0;
+  for (const auto& [u, v] : edges) {
+    if (!edges.contains({v, u}) && distance2(crop.xyz, u) < 0.006 * 0.006 &&
+        distance2(crop.xyz, v) < 0.006 * 0.006) {
+      ++open_near;
+    }
+  }
+  EXPECT_EQ(open_near, 0u);
+  g2s::test_support::expect_clean_mesh(
+      g2s::compute_stats({crop.xyz, std::move(mesh.triangles)}, &crop));
+}
+
 // Baselines measured through mesh_cloud (the tiled path `g2s mesh` runs, default options and
 // memory budget) after the surface finishing step (no crossings, holes filled): boundary edges and
 // holes plus 5% (rounded up; one more hole where the count is tiny), coverage minus 0.002. Lower
@@ -165,17 +209,19 @@ TEST(RealScanGaps, WideningHolesLeavesFewerHolesAndOnlyPointsNearTheSurfaceOut) 
 // when a widened border could grow by six edges a ring and holes whose widening met a filling of
 // the same round were tried again (holes 662 -> 567 on raw-bunny, coverage 0.9827 -> 0.9795), and
 // when growth began refusing crossing triangles instead of removing them afterwards (holes 567 ->
-// 560 on raw-bunny, 211 -> 201 on autzen, 27,017 -> 25,657 on alpe).
+// 560 on raw-bunny, 211 -> 201 on autzen, 27,017 -> 25,657 on alpe), and when holes under a fold
+// were widened by just the fold (560 -> 551 on raw-bunny, 384 -> 380 on lion, 58 -> 57 on
+// table-mug, 25,657 -> 25,437 on alpe).
 INSTANTIATE_TEST_SUITE_P(
     SharedData, RealScan,
     ::testing::Values(Baseline{"closed-kitten", true, 0.995, 0, 0, 0.995},
                       Baseline{"closed-bunny-zipper", true, 0.995, 8, 1, 0.995},
                       Baseline{"open-bunny-scan-bun000", false, 0.9977, 690, 7, 0.995},
-                      Baseline{"raw-bunny", false, 0.9774, 15960, 588, 0.97},
-                      Baseline{"open-table-mug-stereo", false, 0.9918, 4944, 61, 0.97},
-                      Baseline{"open-lion-photogrammetry", false, 0.9911, 16131, 402, 0.97},
+                      Baseline{"raw-bunny", false, 0.9774, 15960, 579, 0.97},
+                      Baseline{"open-table-mug-stereo", false, 0.9918, 4921, 60, 0.97},
+                      Baseline{"open-lion-photogrammetry", false, 0.9911, 16127, 399, 0.97},
                       Baseline{"open-autzen-lidar", false, 0.9904, 9442, 211, 0.995},
-                      Baseline{"open-alpe-selle-photogrammetry", false, 0.9759, 2421503, 26940,
+                      Baseline{"open-alpe-selle-photogrammetry", false, 0.9759, 2419583, 26709,
                                0.97}),
     [](const ::testing::TestParamInfo<Baseline>& param) {
       std::string name = param.param.name;
