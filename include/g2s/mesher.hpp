@@ -44,7 +44,9 @@ struct MeshOptions {
   // folds over it) may be widened by up to this many rings of triangles around it and filled in
   // their place (after r rings its border may have max_hole_edges + 6r edges, at most
   // kMaxHoleEdges), leaving out the points inside that lie within 3 spacings of the surface
-  // (docs/algorithm.md, "Hole filling"); scraps (pieces with no interior point within 3 spacings
+  // (docs/algorithm.md, "Hole filling"); a hole still open, when only triangles of its corners'
+  // fans folded over it refuse its filling, is widened by those and the ring across its edges
+  // ("Folds over a hole"); scraps (pieces with no interior point within 3 spacings
   // of another piece) are removed too, when holes are filled at all (max_hole_edges >= 3). 0: every
   // hole is filled over its own loop or not at all, and no point is left out. At most
   // kMaxHoleRings.
