@@ -38,6 +38,26 @@ class LocalFrame {
     }
     return r;
   }
+  // Whether point p's float in the frame (point()) is p less the origin exactly, and so whether
+  // the mesher decides on p itself: always for floats read from a file (see origin()), not for
+  // coordinates finer than float (a double PLY, a LAS file's scaled integers).
+  bool exact(const double* p) const {
+    for (int a = 0; a < 3; ++a) {
+      // d = p - origin rounded, and the rounding error (TwoSum): exact when it is 0.
+      const double d = p[a] - centre_[a], back = d - p[a];
+      const double error = (p[a] - (d - back)) + (-centre_[a] - back);
+      if (error != 0 || static_cast<double>(static_cast<float>(d)) != d) return false;
+    }
+    return true;
+  }
+  // Whether every point of xyz (3 doubles each) is exact in the frame.
+  bool exact(std::span<const double> xyz) const {
+    for (std::size_t k = 0; k + 2 < xyz.size(); k += 3) {
+      if (!exact(&xyz[k])) return false;
+    }
+    return true;
+  }
+  Vec3 origin() const { return {centre_[0], centre_[1], centre_[2]}; }
   // All points of xyz (3 doubles each) in the frame.
   std::vector<float> convert(std::span<const double> xyz) const {
     std::vector<float> local(xyz.size());
@@ -58,7 +78,9 @@ class LocalFrame {
   // rounded to the step, it would leave the range up to half a step (3.4e7 at 1e15) from zero,
   // where float cannot tell its points apart and the crossing test's margins (relative to the
   // coordinates) swallow the spacing. Floats read from a file lie a step apart, so such a range
-  // of them is one value, and minus the origin it is 0.
+  // of them is one value, and minus the origin it is 0. Coordinates finer than float are rounded
+  // here; exact() says so, and the crossing tests then read the input's own coordinates instead
+  // (detail::CrossingPositions).
   static double origin(double lo, double hi) {
     const double width = hi - lo;
     const double near = std::min(std::abs(lo - width), std::abs(hi + width));

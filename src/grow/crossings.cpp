@@ -41,6 +41,71 @@ bool padded_circumball(const Vec3& a, const Vec3& b, const Vec3& c, Ball& out) {
   return true;
 }
 
+CrossingPositions::CrossingPositions(const HashGrid& grid, std::span<const Vec3> exact,
+                                     const Vec3& origin)
+    : grid_(grid), exact_(exact), origin_(origin) {
+  // Rounding to float moves a coordinate by at most 2^-24 of it: a point by 2^-24 of its norm.
+  double farthest = 0;
+  for (std::uint32_t k = 0; k < exact.size(); ++k)
+    farthest = std::max(farthest, norm(grid.position(k)));
+  rounding_ = std::ldexp(farthest, -23);
+}
+
+std::vector<Vec3> output_positions(const HashGrid& grid, std::span<const double> xyz,
+                                   bool floats_exact) {
+  std::vector<Vec3> out;
+  if (floats_exact) return out;
+  out.reserve(grid.size());
+  for (std::uint32_t k = 0; k < grid.size(); ++k) {
+    const double* p = &xyz[3 * std::size_t{grid.source(k)}];
+    out.push_back({p[0], p[1], p[2]});
+  }
+  return out;
+}
+
+SeparatingPlanes CrossingPositions::planes(const Triangle& t) const {
+  if (exact_.empty()) return SeparatingPlanes(grid_.points(), t);
+  return SeparatingPlanes(t, [&](Index v) { return exact_[v]; });
+}
+
+bool CrossingPositions::separate(const SeparatingPlanes& planes, const Triangle& other) const {
+  if (exact_.empty()) return planes.separate(grid_.points(), other);
+  return planes.separate(other, [&](Index v) { return exact_[v]; });
+}
+
+bool CrossingPositions::cross(const Triangle& a, const Triangle& b) const {
+  if (exact_.empty()) return triangles_cross(grid_.points(), a, b);
+  if (a[0] == b[0] && a[1] == b[1] && a[2] == b[2]) return false;
+  const Vec3 ta[3] = {exact_[a[0]], exact_[a[1]], exact_[a[2]]};
+  const Vec3 tb[3] = {exact_[b[0]], exact_[b[1]], exact_[b[2]]};
+  return g2s::triangles_cross(ta, tb);
+}
+
+bool CrossingPositions::degenerate(const Triangle& t) const {
+  if (exact_.empty()) return detail::degenerate(grid_.points(), t);
+  double p[3][3];
+  for (int k = 0; k < 3; ++k) {
+    const Vec3& v = exact_[t[k]];
+    p[k][0] = v.x, p[k][1] = v.y, p[k][2] = v.z;
+  }
+  return exact::collinear(p[0], p[1], p[2]);
+}
+
+bool CrossingPositions::ball(const Triangle& t, Ball& out) const {
+  if (exact_.empty()) {
+    return padded_circumball(grid_.position(t[0]), grid_.position(t[1]), grid_.position(t[2]), out);
+  }
+  // In the frame (the subtraction's rounding is far below the padding), widened by the most
+  // any point's float lies from its position.
+  if (!padded_circumball(exact_[t[0]] - origin_, exact_[t[1]] - origin_, exact_[t[2]] - origin_,
+                         out)) {
+    return false;
+  }
+  const double reach = std::sqrt(out.radius2) + rounding_;
+  out.radius2 = reach * reach;
+  return true;
+}
+
 namespace {
 using Pairs = std::vector<std::pair<std::uint32_t, std::uint32_t>>;
 
@@ -53,17 +118,17 @@ Pairs sorted_union(tbb::enumerable_thread_specific<Pairs>& found) {
 }
 }  // namespace
 
-CrossingGuard::CrossingGuard(const HashGrid& grid)
-    : grid_(grid), star_head_(grid.size(), kNoIndex), held_head_(grid.size(), kNoIndex) {}
+CrossingGuard::CrossingGuard(const HashGrid& grid, const CrossingPositions& positions)
+    : grid_(grid),
+      positions_(positions),
+      star_head_(grid.size(), kNoIndex),
+      held_head_(grid.size(), kNoIndex) {}
 
 bool CrossingGuard::gather(const Triangle& tri) {
   gathered_ = tri;
   in_ball_.clear();
   Ball ball;
-  if (!padded_circumball(grid_.position(tri[0]), grid_.position(tri[1]), grid_.position(tri[2]),
-                         ball)) {
-    return false;
-  }
+  if (!positions_.ball(tri, ball)) return false;
   grid_.for_each_in_ball(ball.centre, std::sqrt(ball.radius2), [&](std::uint32_t j, double) {
     if (j != tri[0] && j != tri[1] && j != tri[2]) in_ball_.push_back(j);
   });
@@ -74,9 +139,8 @@ bool CrossingGuard::crosses(const Triangle& tri, std::span<const Triangle> made)
   if (!gather(tri)) return true;
   std::optional<SeparatingPlanes> planes;
   const auto crosses_one = [&](std::uint32_t other) {
-    if (!planes) planes.emplace(grid_.points(), tri);
-    return !planes->separate(grid_.points(), made[other]) &&
-           triangles_cross(grid_.points(), tri, made[other]);
+    if (!planes) planes.emplace(positions_.planes(tri));
+    return !positions_.separate(*planes, made[other]) && positions_.cross(tri, made[other]);
   };
   for (const Index v : in_ball_) {
     for (std::uint32_t at = star_head_[v]; at != kNoIndex; at = star_next_[at]) {
@@ -105,12 +169,12 @@ void CrossingGuard::file(std::uint32_t t, std::span<const Triangle> made) {
   }
 }
 
-Pairs TriangleCells::crossing_pairs() const {
+Pairs TriangleCells::crossing_pairs(const CrossingPositions& positions) const {
   std::vector<std::uint8_t> collinear(triangles_.size());  // degenerate triangles cross none
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, triangles_.size(), 4096),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t t = range.begin(); t < range.end(); ++t) {
-                        collinear[t] = degenerate(points_, triangles_[t]);
+                        collinear[t] = positions.degenerate(triangles_[t]);
                       }
                     });
   const Level& first = levels_[0];
@@ -123,7 +187,7 @@ Pairs TriangleCells::crossing_pairs() const {
       if (!overlap(first.boxes[i], first.boxes[j])) return;
       const std::uint32_t s = first.filed[i], t = first.filed[j];
       if (collinear[s] || collinear[t]) return;
-      if (triangles_cross(points_, triangles_[s], triangles_[t])) {
+      if (positions.cross(triangles_[s], triangles_[t])) {
         pairs.push_back({std::min(s, t), std::max(s, t)});
       }
     };
@@ -155,7 +219,7 @@ Pairs TriangleCells::crossing_pairs() const {
     for_each_near(box.lo, box.hi, [&](std::uint32_t other, const Box&) {
       if (other == t || (level_[other] != 0 && other < t)) return;
       if (collinear[t] || collinear[other]) return;
-      if (triangles_cross(points_, triangles_[t], triangles_[other])) {
+      if (positions.cross(triangles_[t], triangles_[other])) {
         pairs.push_back({std::min(t, other), std::max(t, other)});
       }
     });

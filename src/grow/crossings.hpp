@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "common/separating_planes.hpp"
 #include "common/vec3.hpp"
 #include "g2s/types.hpp"
 #include "grid/hash_grid.hpp"
@@ -28,6 +29,45 @@ bool padded_circumball(const Vec3& a, const Vec3& b, const Vec3& c, Ball& out);
 // positions; neither degenerate) intersect other than in corners or an edge they share; exact
 // (common/triangle_intersection.hpp). The same triangle twice never crosses.
 bool triangles_cross(std::span<const Vec3f> points, const Triangle& a, const Triangle& b);
+
+// The positions the crossing tests decide on: the ones the output holds (the input's double
+// coordinates), so that a mesh the tests pass has no crossing once written. Where the grid's
+// floats are exactly those less the frame's origin (a cloud read as float: LocalFrame), the
+// floats are tested; otherwise (coordinates finer than float, as in a double PLY or a LAS file)
+// the output's positions are, and balls are widened by float's rounding, so that the grid's
+// float searches still find every point a ball of the output's positions holds. Boxes stay
+// float: rounding keeps order, so boxes that overlap in the output's positions overlap in float.
+class CrossingPositions {
+ public:
+  // Inputs: the grid; exact, per grid point its position in the output (empty: the floats are
+  // exact); origin, the grid frame's origin in those positions (grid.point(k) is exact[k] -
+  // origin rounded to float). The spans must outlive the object.
+  explicit CrossingPositions(const HashGrid& grid, std::span<const Vec3> exact = {},
+                             const Vec3& origin = {});
+
+  // Separating planes of t (common/separating_planes.hpp), and whether they separate `other`.
+  SeparatingPlanes planes(const Triangle& t) const;
+  bool separate(const SeparatingPlanes& planes, const Triangle& other) const;
+  // Whether the triangles cross (triangles_cross, on these positions).
+  bool cross(const Triangle& a, const Triangle& b) const;
+  // Whether t's corners lie on one line (exactly).
+  bool degenerate(const Triangle& t) const;
+  // A ball in the grid's float frame that holds every point whose position lies in t's padded
+  // circumball (padded_circumball, on these positions); false for a sliver.
+  bool ball(const Triangle& t, Ball& out) const;
+
+ private:
+  const HashGrid& grid_;
+  std::span<const Vec3> exact_;
+  Vec3 origin_;
+  double rounding_ = 0;  // how far a float point may lie from its exact position, at most
+};
+
+// The positions GrowContext::exact_positions asks for: per grid point its coordinates in xyz (3
+// doubles per point the grid was built from, in that order), or none when floats_exact (the
+// grid's floats are those coordinates less the frame's origin, LocalFrame::exact).
+std::vector<Vec3> output_positions(const HashGrid& grid, std::span<const double> xyz,
+                                   bool floats_exact);
 
 // An axis-aligned box: two triangles whose boxes do not overlap cannot cross.
 struct Box {
@@ -62,8 +102,9 @@ inline Box box_of(std::span<const Vec3f> points, const Triangle& t) {
 // where the separating planes (common/separating_planes.hpp) do not settle a pair.
 class CrossingGuard {
  public:
-  // Inputs: the grid whose points the triangles' corners index. It must outlive the guard.
-  explicit CrossingGuard(const HashGrid& grid);
+  // Inputs: the grid whose points the triangles' corners index, and the positions the tests
+  // decide on. Both must outlive the guard.
+  CrossingGuard(const HashGrid& grid, const CrossingPositions& positions);
   // Inputs: a triangle with a circumball (not filed), and `made`, the triangles filed so far by
   // their indices. Output: whether it crosses a filed triangle (true also for a sliver without
   // a circumball, which the grower never makes).
@@ -80,6 +121,7 @@ class CrossingGuard {
     std::uint32_t triangle, next;
   };
   const HashGrid& grid_;
+  const CrossingPositions& positions_;
   std::vector<std::uint32_t> star_head_;  // per point: its last corner slot 3t+k, or kNoIndex
   std::vector<std::uint32_t> star_next_;  // per corner slot: the point's corner filed before
   std::vector<std::uint32_t> held_head_;  // per point: its last entry in held_, or kNoIndex
@@ -104,8 +146,10 @@ class TriangleCells {
   template <class Visit>
   void for_each_near(const Vec3f& lo, const Vec3f& hi, Visit&& visit) const;
 
-  // Every pair (s, t), s < t, of non-degenerate triangles that cross (triangles_cross). Sorted.
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_pairs() const;
+  // Every pair (s, t), s < t, of non-degenerate triangles that cross, judged on `positions`
+  // (of the same points). Sorted.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing_pairs(
+      const CrossingPositions& positions) const;
 
  private:
   // One size of cell: per filed triangle, in cell order; cells in an open-addressing table at

@@ -75,7 +75,8 @@ class Grower {
         flat_levels_(std::max(1, options.flatness_levels)),
         edges_(grid.size()),
         seed_tried_(grid.size(), 0),
-        guard_(std::in_place, grid),
+        positions_(grid, context.exact_positions, context.exact_origin),
+        guard_(std::in_place, grid, positions_),
         state_(grid.size(), 0),
         queue_(std::max(1, levels_ * flat_levels_)),
         last_priority_(std::max(1, levels_ * flat_levels_) - 1),
@@ -1273,10 +1274,10 @@ class Grower {
     std::optional<SeparatingPlanes> planes;
     const auto blocks = [&](const NearTriangle& near) {
       const Triangle& o = triangles_[near.index];
-      if (!planes) planes.emplace(grid_.points(), t);
-      if (planes->separate(grid_.points(), o)) return false;
+      if (!planes) planes.emplace(positions_.planes(t));
+      if (positions_.separate(*planes, o)) return false;
       if (std::is_permutation(o.begin(), o.end(), t.begin())) return true;
-      return detail::triangles_cross(grid_.points(), t, o);
+      return positions_.cross(t, o);
     };
     // The triangle that refused the last candidate is asked first: where the surface folds over
     // a hole, one grown triangle refuses most of the candidates across it.
@@ -1313,12 +1314,12 @@ class Grower {
   bool survey_crossings(const Triangle& t) {
     if (off_the_fans_) return true;
     const detail::Box box = detail::box_of(grid_.points(), t);
-    const SeparatingPlanes planes(grid_.points(), t);
+    const SeparatingPlanes planes = positions_.planes(t);
     const std::size_t before = folded_over_.size();
     for (const NearTriangle& near : loop_near_) {
       const Triangle& other = triangles_[near.index];
-      if (!detail::overlap(box, near.box) || planes.separate(grid_.points(), other) ||
-          !detail::triangles_cross(grid_.points(), t, other)) {
+      if (!detail::overlap(box, near.box) || positions_.separate(planes, other) ||
+          !positions_.cross(t, other)) {
         continue;
       }
       if (std::none_of(other.begin(), other.end(), [&](Index v) {
@@ -1350,7 +1351,7 @@ class Grower {
     if (triangles_.size() > first_fill) {
       const std::span<const Triangle> fills =
           std::span<const Triangle>(triangles_).subspan(first_fill);
-      const auto pairs = detail::TriangleCells(grid_.points(), fills).crossing_pairs();
+      const auto pairs = detail::TriangleCells(grid_.points(), fills).crossing_pairs(positions_);
       for (const auto& [first, second] : pairs) {
         const FillRecord& earlier = fill_records_[fill_loop_[first]];
         const FillRecord& later = fill_records_[fill_loop_[second]];
@@ -1690,6 +1691,7 @@ class Grower {
   std::vector<Index> second_fans_;
   EdgeMap edges_;
   std::vector<std::uint8_t> seed_tried_;
+  const detail::CrossingPositions positions_;   // what crossings are judged on
   std::optional<detail::CrossingGuard> guard_;  // while growth lasts
   // Per point: kUsed once it is a corner, plus the number of open edges at it; one array, so
   // that the interior test of every point a search ball holds is a single load.

@@ -39,6 +39,12 @@ struct GrowContext {
   // sampling needs, and a grid whose sampled spacing only seems larger does not reach farther
   // (one tile and many then cap alike). With 0, the cap is the grid's own spacing.
   double cloud_spacing = 0;
+  // Per grid point, its position as the output holds it (the input's coordinates), where the
+  // grid's floats are not exactly those less the frame's origin (coordinates finer than float):
+  // crossings are then judged on these, so that the written mesh has none
+  // (detail::CrossingPositions). Empty: the floats are exact. exact_origin: the frame's origin.
+  std::span<const Vec3> exact_positions{};
+  Vec3 exact_origin{0, 0, 0};
 };
 
 struct GrowResult {

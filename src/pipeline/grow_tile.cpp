@@ -21,6 +21,7 @@
 #include "common/local_frame.hpp"
 #include "g2s/tile_stages.hpp"
 #include "grid/hash_grid.hpp"
+#include "grow/crossings.hpp"
 #include "grow/grower.hpp"
 #include "stitch/seam_reach.hpp"
 
@@ -112,8 +113,11 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
       points.xyz.insert(points.xyz.end(), &border.xyz[3 * k], &border.xyz[3 * k + 3]);
     }
   }
-  const std::vector<float> local = tile_frame(tiles[tile]).convert(points.xyz);
+  const LocalFrame frame = tile_frame(tiles[tile]);
+  const std::vector<float> local = frame.convert(points.xyz);
   const HashGrid grid(local, points.ids, source.group_distance(), source.twin_distance());
+  const std::vector<Vec3> exact =
+      detail::output_positions(grid, points.xyz, frame.exact(points.xyz));
   out.report.points = own;
   out.report.spacing = grid.spacing();
   out.report.seconds_grid =
@@ -131,6 +135,8 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
   GrowContext context;
   context.fillable = fillable;
   context.cloud_spacing = source.cloud_spacing();
+  context.exact_positions = exact;
+  context.exact_origin = frame.origin();
   GrowResult grown = grow_mesh(grid, mesh_options, context);
   fillable = std::vector<std::uint8_t>();
   out.report.seeds = grown.seeds;

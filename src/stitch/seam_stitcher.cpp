@@ -150,9 +150,14 @@ class SeamStitcher {
     // that corners kept apart in their tiles' frames stay apart here.
     const LocalFrame frame = finer_frame(tile_frame(tiles[tile]), points_box(seam_xyz_, box));
     local_ = frame.convert(seam_xyz_);
+    bool floats_exact = frame.exact(seam_xyz_);
     context_corners_.clear();
+    context_xyz_.clear();
     for (const Index s : context_slots_) {
-      context_corners_.push_back(frame.point(&live.xyz[3 * std::size_t{s}]));
+      const double* p = &live.xyz[3 * std::size_t{s}];
+      context_corners_.push_back(frame.point(p));
+      context_xyz_.push_back({p[0], p[1], p[2]});
+      floats_exact = floats_exact && frame.exact(p);
     }
 
     // Kept corners stay in the grid in a cloud of twins: a seam's float frame may judge a pair at
@@ -192,9 +197,12 @@ class SeamStitcher {
 
     MeshOptions mesh_options = options_.mesh;
     mesh_options.progress = {};
+    exact_ = detail::output_positions(grid, seam_xyz_, floats_exact);
     GrowContext context{preload_, preload_group_, growable, links_, options_.stitch_retries, {}};
     context.fillable = fillable;
     context.cloud_spacing = source_.cloud_spacing();
+    context.exact_positions = exact_;
+    context.exact_origin = frame.origin();
     GrowResult grown = grow_mesh(grid, mesh_options, context);
     const std::vector<std::uint8_t> crossing = crossing_context(grid, grown.triangles);
 
@@ -279,9 +287,15 @@ class SeamStitcher {
       const detail::Box box = detail::enclose(
           detail::enclose({live_corners[0], live_corners[0]}, live_corners[1]), live_corners[2]);
       cells.for_each_near(box.lo, box.hi, [&](std::uint32_t k, const detail::Box&) {
-        const Vec3f corners[3] = {grid.point(made[k][0]), grid.point(made[k][1]),
-                                  grid.point(made[k][2])};
-        if (!crossing[k] && triangles_cross(corners, live_corners)) crossing[k] = 1;
+        if (crossing[k]) return;
+        const Triangle& t = made[k];
+        if (exact_.empty()) {
+          const Vec3f corners[3] = {grid.point(t[0]), grid.point(t[1]), grid.point(t[2])};
+          crossing[k] = triangles_cross(corners, live_corners);
+        } else {
+          const Vec3 corners[3] = {exact_[t[0]], exact_[t[1]], exact_[t[2]]};
+          crossing[k] = triangles_cross(corners, &context_xyz_[x]);
+        }
       });
     }
     return crossing;
@@ -373,6 +387,10 @@ class SeamStitcher {
   std::vector<double> seam_xyz_;             // per point of ids_: its position
   std::vector<Index> context_slots_;         // per live triangle touching only context: its corners
   std::vector<Vec3f> context_corners_;       // and their positions in the seam's frame
+  std::vector<Vec3> context_xyz_;            // and in the output (the input's coordinates)
+  // Per grid point of the seam, its position in the output, where the seam's floats are not
+  // exactly those (GrowContext::exact_positions); else empty.
+  std::vector<Vec3> exact_;
   // The orientation vote's scratch: per seam grid point, its label and normal.
   std::vector<std::uint32_t> label_;
   std::vector<Vec3> normal_;

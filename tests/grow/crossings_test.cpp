@@ -10,7 +10,9 @@
 
 #include <random>
 
+#include "common/exact_predicates.hpp"
 #include "common/separating_planes.hpp"
+#include "common/triangle_intersection.hpp"
 #include "grid/hash_grid.hpp"
 
 namespace g2s {
@@ -74,7 +76,8 @@ Pairs brute_force_pairs(const Soup& soup) {
 // The triangles refused when each is asked about in turn and the others made, the first `fixed`
 // made without asking (a seam's preload): by a guard, or by a test against every one made.
 std::vector<std::uint32_t> refusals(const Soup& soup, std::size_t fixed, bool brute_force) {
-  detail::CrossingGuard guard(soup.grid);
+  const detail::CrossingPositions positions(soup.grid);
+  detail::CrossingGuard guard(soup.grid, positions);
   std::vector<Triangle> made;
   std::vector<std::uint32_t> refused;
   for (std::uint32_t t = 0; t < soup.triangles.size(); ++t) {
@@ -125,7 +128,9 @@ TEST(Crossings, TheGuardAndTheCellsAnswerAsATestOfEveryPair) {
     const std::vector<std::uint32_t> refused = refusals(soup, 0, true);
     ASSERT_GT(refused.size(), 30u);
     EXPECT_EQ(refusals(soup, 0, false), refused);
-    EXPECT_EQ(detail::TriangleCells(soup.grid.points(), soup.triangles).crossing_pairs(), expected);
+    EXPECT_EQ(detail::TriangleCells(soup.grid.points(), soup.triangles)
+                  .crossing_pairs(detail::CrossingPositions(soup.grid)),
+              expected);
   }
 }
 
@@ -193,7 +198,8 @@ TEST(Crossings, ASliverHasNoCircumballAndIsRefused) {
                               soup.grid.position(sliver[2])));
   ASSERT_FALSE(detail::degenerate(soup.grid.points(), sliver));
   ASSERT_TRUE(detail::triangles_cross(soup.grid.points(), soup.triangles[0], sliver));
-  detail::CrossingGuard guard(soup.grid);
+  const detail::CrossingPositions positions(soup.grid);
+  detail::CrossingGuard guard(soup.grid, positions);
   EXPECT_TRUE(guard.crosses(sliver, {}));
 }
 
@@ -253,6 +259,66 @@ TEST(Crossings, FourPointsOnOneCircleAreSearched) {
   ASSERT_EQ(brute_force_pairs(soup).size(), 4u);  // each split against each triangle of the other
   EXPECT_EQ(refusals(soup, 0, false), (std::vector<std::uint32_t>{2, 3}));
   EXPECT_EQ(refusals(soup, 0, true), (std::vector<std::uint32_t>{2, 3}));
+}
+
+// Coordinates finer than float (a double PLY, a LAS file): a triangle whose corner pierces another
+// by less than float's rounding crosses it in the coordinates the output holds, while their floats
+// put the corner on the other side. Given those coordinates, the guard and the cells judge on
+// them and refuse it; on the floats alone they would not.
+TEST(Crossings, ExactPositionsCatchACrossingFloatRoundingHides) {
+  const double a[3][3] = {{0.1, 0.1, 1.0}, {1.1, 0.2, 1.3}, {0.2, 1.1, 0.7}};
+  const auto as_float = [](const double* p) {
+    return std::array<double, 3>{static_cast<float>(p[0]), static_cast<float>(p[1]),
+                                 static_cast<float>(p[2])};
+  };
+  std::array<std::array<double, 3>, 3> a_float{};
+  for (int k = 0; k < 3; ++k) a_float[k] = as_float(a[k]);
+  // Walk a corner across A's plane near its centroid in steps far below float's, until the doubles
+  // put it below A and the floats above.
+  const double normal[3] = {-0.29, 0.33, 0.97}, centroid[3] = {0.4666, 0.4666, 1.0};
+  double p[3] = {};
+  bool found = false;
+  for (int step = -4000; step <= 4000 && !found; ++step) {
+    for (int k = 0; k < 3; ++k) p[k] = centroid[k] + 1e-10 * step * normal[k];
+    const auto pf = as_float(p);
+    found = exact::orient3d(a[0], a[1], a[2], p) * exact::orient3d(a[0], a[1], a[2], normal) < 0 &&
+            exact::orient3d(a_float[0].data(), a_float[1].data(), a_float[2].data(), pf.data()) *
+                    exact::orient3d(a[0], a[1], a[2], normal) >
+                0;
+  }
+  ASSERT_TRUE(found) << "no corner that float rounding moves across the plane";
+  std::vector<double> xyz;
+  for (const auto& corner : a) xyz.insert(xyz.end(), corner, corner + 3);
+  // B: p and two corners well above A, so that only p's side decides.
+  xyz.insert(xyz.end(), p, p + 3);
+  for (const double lift : {0.3, 0.4}) {
+    xyz.insert(xyz.end(), {p[0] + 0.02 * lift, p[1] + 0.01, p[2] + lift});
+  }
+  xyz[15] -= 0.01;
+  std::vector<float> floats(xyz.begin(), xyz.end());
+  const Soup soup = soup_of(floats, {{0, 1, 2}, {3, 4, 5}});
+  const Triangle& first = soup.triangles[0];
+  const Triangle& second = soup.triangles[1];
+  ASSERT_FALSE(detail::triangles_cross(soup.grid.points(), first, second));
+
+  const std::vector<Vec3> exact = detail::output_positions(soup.grid, xyz, false);
+  const Vec3 da[3] = {exact[first[0]], exact[first[1]], exact[first[2]]};
+  const Vec3 db[3] = {exact[second[0]], exact[second[1]], exact[second[2]]};
+  ASSERT_TRUE(triangles_cross(da, db));
+  EXPECT_TRUE(detail::output_positions(soup.grid, xyz, true).empty());
+
+  const detail::CrossingPositions on_floats(soup.grid), on_exact(soup.grid, exact);
+  EXPECT_FALSE(on_floats.cross(first, second));
+  EXPECT_TRUE(on_exact.cross(first, second));
+  for (const detail::CrossingPositions* positions : {&on_floats, &on_exact}) {
+    detail::CrossingGuard guard(soup.grid, *positions);
+    guard.file(0, soup.triangles);
+    EXPECT_EQ(guard.crosses(second, std::span<const Triangle>(soup.triangles).first(1)),
+              positions == &on_exact);
+    EXPECT_EQ(
+        detail::TriangleCells(soup.grid.points(), soup.triangles).crossing_pairs(*positions).size(),
+        positions == &on_exact ? 1u : 0u);
+  }
 }
 
 }  // namespace
