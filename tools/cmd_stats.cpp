@@ -55,8 +55,9 @@ void add_stats_command(CLI::App& app) {
   cmd->add_option("MESH", args->mesh, "Mesh to measure (.stl binary or ASCII, .ply)")->required();
   cmd->add_option(
       "--points", args->points,
-      "Input cloud (PLY, LAS, XYZ): adds its coverage, compared at float precision, and the\n"
-      "distances of its other points to the mesh, in sampling spacings");
+      "Input cloud (PLY, LAS, XYZ): adds its coverage (compared at float precision when every\n"
+      "vertex is a float, as in STL, else exactly) and the distances of its other points to\n"
+      "the mesh, in sampling spacings");
   cmd->add_flag("--json", args->json, "Print one JSON object instead of text");
   cmd->add_flag("--largest-component", args->largest,
                 "Measure only the largest connected piece (most triangles), e.g. a scan's own\n"

@@ -76,8 +76,10 @@ struct MeshStats {
 //   statistics"). Candidate pairs come from a grid of the triangles' boxes; this part runs in
 //   parallel in the caller's TBB arena, with the same counts for any thread count.
 // - Coverage, when input_points is given: an input point is covered when a vertex of a kept
-//   triangle has the same coordinates after both are rounded to float, because STL stores
-//   float32 and an STL mesh of a double-precision cloud must still cover it. Every given point
+//   triangle has its coordinates. Where every such vertex lies on floats (as in any STL), both
+//   are rounded to float first, so that an STL of a double-precision cloud still covers it;
+//   otherwise they are compared exactly (at georeferenced coordinates float's step is half a
+//   metre, and a double mesh's points that far apart are not one). Every given point
 //   counts, duplicates included; coverage is 0 for an empty cloud. The points not covered are
 //   then measured against the mesh (see has_distances), in parallel.
 // Throws Error(bad_input) when a triangle indexes a vertex past the end of mesh.xyz.

@@ -246,10 +246,12 @@ struct EdgeGroup {
   std::uint32_t out;  // how many traverse it v -> w
 };
 
-// A set of the used vertices' positions rounded to float (STL's precision), for coverage.
-class FloatPositionSet {
+// A set of the used vertices' positions, for coverage: rounded to float (STL's precision) when
+// kFloat, else exact.
+template <bool kFloat>
+class PositionSet {
  public:
-  explicit FloatPositionSet(std::size_t count) : keys_(table_capacity(count), kEmpty) {}
+  explicit PositionSet(std::size_t count) : keys_(table_capacity(count), kEmpty) {}
 
   // Starts loading the slot where p's key would be looked up first.
   void prepare(const double* p) const {
@@ -271,16 +273,21 @@ class FloatPositionSet {
   }
 
  private:
+  using Bits = std::conditional_t<kFloat, std::uint32_t, std::uint64_t>;
   struct Key {
-    std::uint32_t x, y, z;
+    Bits x, y, z;
     // Member by member: std::array's == becomes a memcmp call in this hot loop.
     bool operator==(const Key& o) const { return x == o.x && y == o.y && z == o.z; }
   };
-  static constexpr Key kEmpty = {0xFFFFFFFFu, 0xFFFFFFFFu, 0xFFFFFFFFu};  // a NaN pattern
+  static constexpr Key kEmpty = {~Bits{0}, ~Bits{0}, ~Bits{0}};  // a NaN pattern
 
   static Key make_key(const double* p) {
-    return {key_bits(static_cast<float>(p[0])), key_bits(static_cast<float>(p[1])),
-            key_bits(static_cast<float>(p[2]))};
+    if constexpr (kFloat) {
+      return {key_bits(static_cast<float>(p[0])), key_bits(static_cast<float>(p[1])),
+              key_bits(static_cast<float>(p[2]))};
+    } else {
+      return {key_bits(p[0]), key_bits(p[1]), key_bits(p[2])};
+    }
   }
   // The slot holding `key`, or the empty slot where it would go.
   std::size_t find(const Key& key) const {
@@ -293,6 +300,29 @@ class FloatPositionSet {
   Table<Key> keys_;
   bool has_empty_key_ = false;
 };
+
+// Counts in stats the input points whose position a used vertex has (vertex(w): welded vertex
+// w's coordinates, used(w): whether a kept triangle uses it); the others go to off_mesh.
+template <bool kFloat, class Vertex, class Used>
+void cover(std::size_t vertex_count, Vertex&& vertex, Used&& used, const PointCloud& input_points,
+           MeshStats& stats, Table<std::uint64_t>& off_mesh) {
+  PositionSet<kFloat> positions(stats.vertices);
+  constexpr std::size_t kAhead = 16;
+  for (std::size_t w = 0; w < vertex_count; ++w) {
+    if (w + kAhead < vertex_count) positions.prepare(vertex(w + kAhead));
+    if (used(w)) positions.insert(vertex(w));
+  }
+  const std::size_t points = input_points.size();
+  const double* point = input_points.xyz.data();
+  for (std::size_t i = 0; i < points; ++i) {
+    if (i + kAhead < points) positions.prepare(point + 3 * (i + kAhead));
+    if (positions.contains(point + 3 * i)) {
+      ++stats.covered_points;
+    } else {
+      off_mesh.push_back(i);
+    }
+  }
+}
 
 // Everything that needs a vertex's star: duplicates, edge classes, fans, and the boundary
 // graph's cycles. Offset is the CSR offset type (32-bit when the table is small enough).
@@ -453,24 +483,26 @@ void measure_stars(Table<Triangle>& triangles, std::size_t vertex_count, const T
   Table<Index>().swap(parent);
   Table<std::uint32_t>().swap(slot);
   Table<Index>().swap(star);
-  FloatPositionSet positions(stats.vertices);
-  constexpr std::size_t kAhead = 16;
   auto vertex = [&](std::size_t w) { return mesh.xyz.data() + 3 * std::size_t{rep[w]}; };
-  for (std::size_t w = 0; w < vertex_count; ++w) {
-    if (w + kAhead < vertex_count) positions.prepare(vertex(w + kAhead));
-    if (offset[w + 1] != offset[w]) positions.insert(vertex(w));
+  auto used = [&](std::size_t w) { return offset[w + 1] != offset[w]; };
+  // At float precision (STL's) when every used vertex lies on floats, as an STL's all do, so that
+  // an STL of a double cloud covers it; else exactly, as a double mesh holds the points: at
+  // georeferenced coordinates float's step is half a metre, and points that far apart would count
+  // as one.
+  bool floats = true;
+  for (std::size_t w = 0; w < vertex_count && floats; ++w) {
+    if (!used(w)) continue;
+    for (int k = 0; k < 3; ++k) {
+      floats = floats && static_cast<double>(static_cast<float>(vertex(w)[k])) == vertex(w)[k];
+    }
   }
   const std::size_t points = input_points->size();
-  const double* point = input_points->xyz.data();
   stats.has_coverage = true;
   stats.input_points = points;
-  for (std::size_t i = 0; i < points; ++i) {
-    if (i + kAhead < points) positions.prepare(point + 3 * (i + kAhead));
-    if (positions.contains(point + 3 * i)) {
-      ++stats.covered_points;
-    } else {
-      off_mesh.push_back(i);
-    }
+  if (floats) {
+    cover<true>(vertex_count, vertex, used, *input_points, stats, off_mesh);
+  } else {
+    cover<false>(vertex_count, vertex, used, *input_points, stats, off_mesh);
   }
   stats.coverage =
       points == 0 ? 0.0 : static_cast<double>(stats.covered_points) / static_cast<double>(points);

@@ -518,7 +518,9 @@ TEST(StatsCrossings, CoordinatesBeyondFloatRange) {
 
 // A soup of random small triangles in a box, some big, some along one line: the grid's counts
 // must equal those of testing every pair.
-TEST(StatsCrossings, GridAgreesWithAllPairs) {
+// 1,500 random triangles in a 10 x 10 x 2 box, many crossing, corners snapped to a 1/8 grid so
+// that corners coincide and contacts are exact.
+IndexedMesh crossing_soup() {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> position(0.0, 10.0), offset(-0.6, 0.6);
   IndexedMesh mesh;
@@ -526,7 +528,6 @@ TEST(StatsCrossings, GridAgreesWithAllPairs) {
     const double cx = position(rng), cy = position(rng), cz = position(rng) * 0.2;
     const double scale = t % 100 == 0 ? 12.0 : 1.0;  // a few triangles span the whole soup
     for (int c = 0; c < 3; ++c) {
-      // Snapped to a 1/8 grid so that corners coincide and contacts are exact.
       mesh.xyz.push_back(std::round((cx + scale * offset(rng)) * 8) / 8);
       mesh.xyz.push_back(std::round((cy + scale * offset(rng)) * 8) / 8);
       mesh.xyz.push_back(std::round((cz + scale * offset(rng)) * 8) / 8);
@@ -534,6 +535,29 @@ TEST(StatsCrossings, GridAgreesWithAllPairs) {
     const auto base = static_cast<Index>(3 * t);
     mesh.triangles.push_back({base, base + 1, base + 2});
   }
+  return mesh;
+}
+
+// The soup shrunk to a centimetre and moved to georeferenced coordinates, both exactly (powers
+// of two, then offsets whose sum keeps every bit): the same pairs. Float boxes taken at those
+// coordinates as they are would be half a metre wide, the whole soup in one grid cell.
+TEST(StatsCrossings, GeoreferencedCoordinatesGiveTheSameCounts) {
+  const IndexedMesh soup = crossing_soup();
+  IndexedMesh moved = soup;
+  const double offset[3] = {512345.0, 5123456.0, 312.5};
+  for (std::size_t k = 0; k < moved.xyz.size(); ++k) {
+    moved.xyz[k] = std::ldexp(moved.xyz[k], -10) + offset[k % 3];
+    ASSERT_EQ(moved.xyz[k] - offset[k % 3], std::ldexp(soup.xyz[k], -10));
+  }
+  const g2s::MeshStats s = g2s::compute_stats(soup), m = g2s::compute_stats(moved);
+  EXPECT_GT(s.crossing_pairs, 100u);
+  EXPECT_EQ(m.crossing_pairs, s.crossing_pairs);
+  EXPECT_EQ(m.crossing_pairs_no_shared_vertex, s.crossing_pairs_no_shared_vertex);
+  EXPECT_EQ(m.crossing_triangles, s.crossing_triangles);
+}
+
+TEST(StatsCrossings, GridAgreesWithAllPairs) {
+  const IndexedMesh mesh = crossing_soup();
   const g2s::MeshStats s = g2s::compute_stats(mesh);
   // The same counts on one thread and on three (the caller's arena is respected).
   for (const int threads : {1, 3}) {

@@ -407,39 +407,37 @@ TEST(Stats, TorusAndCylinder) {
   EXPECT_EQ(cylinder.components, 1u);
 }
 
+// Coverage compares at float precision when every vertex lies on floats (an STL's do), so that an
+// STL of a double cloud covers it, and exactly otherwise.
 TEST(Stats, Coverage) {
   IndexedMesh mesh = tetrahedron();
-  mesh.xyz[0] = 0.1;  // vertex 0 at (0.1, 0, 0): not exact in float
+  mesh.xyz[0] = static_cast<float>(0.1);  // vertex 0 at (0.1, 0, 0) as STL's float stores it
   g2s::PointCloud cloud;
-  cloud.xyz = {0.1,
-               0,
-               0,
-               1,
-               0,
-               0,
-               0,
-               1,
-               0,
-               0,
-               0,
-               1,  // the four vertices
-               1,
-               0,
-               0,  // a duplicate point, counted twice
-               static_cast<float>(0.1),
-               -0.0,
-               0,  // vertex 0 as STL's float stores it
-               0.5,
-               0.5,
-               0.5,
-               2,
-               2,
-               2};  // not vertices
+  cloud.xyz = {0.1, -0.0, 0,   1, 0, 0, 0, 1, 0, 0, 0, 1,  // the four vertices, 0.1 as read
+               1,   0,    0,                               // a duplicate point, counted twice
+               0.5, 0.5,  0.5, 2, 2, 2};                   // not vertices
   const MeshStats s = g2s::compute_stats(mesh, &cloud);
   EXPECT_TRUE(s.has_coverage);
-  EXPECT_EQ(s.input_points, 8u);
-  EXPECT_EQ(s.covered_points, 6u);
-  EXPECT_DOUBLE_EQ(s.coverage, 0.75);
+  EXPECT_EQ(s.input_points, 7u);
+  EXPECT_EQ(s.covered_points, 5u);
+  EXPECT_DOUBLE_EQ(s.coverage, 5.0 / 7);
+
+  // A double mesh: 0.1 is covered, its float rounding is another point.
+  mesh.xyz[0] = 0.1;
+  cloud.xyz.insert(cloud.xyz.end(), {static_cast<float>(0.1), 0, 0});
+  const MeshStats exact = g2s::compute_stats(mesh, &cloud);
+  EXPECT_EQ(exact.input_points, 8u);
+  EXPECT_EQ(exact.covered_points, 5u);
+
+  // Georeferenced: float's step is half a metre at 5e6, and points 1 cm apart are not one.
+  IndexedMesh far = tetrahedron();
+  g2s::PointCloud near_far;
+  for (std::size_t k = 0; k < far.xyz.size(); ++k) {
+    far.xyz[k] = far.xyz[k] * 0.01 + (k % 3 == 1 ? 5123456.789 : 512345.678);
+    near_far.xyz.push_back(far.xyz[k]);
+  }
+  for (std::size_t k = 0; k < 3; ++k) near_far.xyz.push_back(far.xyz[k] + 0.005);
+  EXPECT_EQ(g2s::compute_stats(far, &near_far).covered_points, 4u);
 
   const g2s::PointCloud none;
   const MeshStats empty = g2s::compute_stats(mesh, &none);
