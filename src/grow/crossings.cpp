@@ -63,18 +63,16 @@ std::vector<Vec3> output_positions(const HashGrid& grid, std::span<const double>
   return out;
 }
 
-SeparatingPlanes CrossingPositions::planes(const Triangle& t) const {
-  if (exact_.empty()) return SeparatingPlanes(grid_.points(), t);
+SeparatingPlanes CrossingPositions::exact_planes(const Triangle& t) const {
   return SeparatingPlanes(t, [&](Index v) { return exact_[v]; });
 }
 
-bool CrossingPositions::separate(const SeparatingPlanes& planes, const Triangle& other) const {
-  if (exact_.empty()) return planes.separate(grid_.points(), other);
+bool CrossingPositions::exact_separate(const SeparatingPlanes& planes,
+                                       const Triangle& other) const {
   return planes.separate(other, [&](Index v) { return exact_[v]; });
 }
 
-bool CrossingPositions::cross(const Triangle& a, const Triangle& b) const {
-  if (exact_.empty()) return triangles_cross(grid_.points(), a, b);
+bool CrossingPositions::exact_cross(const Triangle& a, const Triangle& b) const {
   if (a[0] == b[0] && a[1] == b[1] && a[2] == b[2]) return false;
   const Vec3 ta[3] = {exact_[a[0]], exact_[a[1]], exact_[a[2]]};
   const Vec3 tb[3] = {exact_[b[0]], exact_[b[1]], exact_[b[2]]};
@@ -91,10 +89,7 @@ bool CrossingPositions::degenerate(const Triangle& t) const {
   return exact::collinear(p[0], p[1], p[2]);
 }
 
-bool CrossingPositions::ball(const Triangle& t, Ball& out) const {
-  if (exact_.empty()) {
-    return padded_circumball(grid_.position(t[0]), grid_.position(t[1]), grid_.position(t[2]), out);
-  }
+bool CrossingPositions::exact_ball(const Triangle& t, Ball& out) const {
   // In the frame (the subtraction's rounding is far below the padding), widened by the most
   // any point's float lies from its position.
   if (!padded_circumball(exact_[t[0]] - origin_, exact_[t[1]] - origin_, exact_[t[2]] - origin_,

@@ -46,17 +46,33 @@ class CrossingPositions {
                              const Vec3& origin = {});
 
   // Separating planes of t (common/separating_planes.hpp), and whether they separate `other`.
-  SeparatingPlanes planes(const Triangle& t) const;
-  bool separate(const SeparatingPlanes& planes, const Triangle& other) const;
+  // The float case inline: these run for every pair a crossing test meets.
+  SeparatingPlanes planes(const Triangle& t) const {
+    return exact_.empty() ? SeparatingPlanes(grid_.points(), t) : exact_planes(t);
+  }
+  bool separate(const SeparatingPlanes& planes, const Triangle& other) const {
+    return exact_.empty() ? planes.separate(grid_.points(), other) : exact_separate(planes, other);
+  }
   // Whether the triangles cross (triangles_cross, on these positions).
-  bool cross(const Triangle& a, const Triangle& b) const;
+  bool cross(const Triangle& a, const Triangle& b) const {
+    return exact_.empty() ? triangles_cross(grid_.points(), a, b) : exact_cross(a, b);
+  }
   // Whether t's corners lie on one line (exactly).
   bool degenerate(const Triangle& t) const;
   // A ball in the grid's float frame that holds every point whose position lies in t's padded
   // circumball (padded_circumball, on these positions); false for a sliver.
-  bool ball(const Triangle& t, Ball& out) const;
+  bool ball(const Triangle& t, Ball& out) const {
+    return exact_.empty() ? padded_circumball(grid_.position(t[0]), grid_.position(t[1]),
+                                              grid_.position(t[2]), out)
+                          : exact_ball(t, out);
+  }
 
  private:
+  SeparatingPlanes exact_planes(const Triangle& t) const;
+  bool exact_separate(const SeparatingPlanes& planes, const Triangle& other) const;
+  bool exact_cross(const Triangle& a, const Triangle& b) const;
+  bool exact_ball(const Triangle& t, Ball& out) const;
+
   const HashGrid& grid_;
   std::span<const Vec3> exact_;
   Vec3 origin_;
