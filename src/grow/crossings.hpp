@@ -1,7 +1,8 @@
 // Crossing triangles: pairs that meet other than in a shared corner or a shared edge. The grower
 // makes no triangle that crosses one made before (CrossingGuard), and checks the triangles it
-// fills holes with against the rest (TriangleCells), so that no mesh it makes crosses itself
-// (docs/algorithm.md, "No crossing triangles").
+// fills holes with against the rest (TriangleCells), both judged on the coordinates the output
+// holds (CrossingPositions), so that no mesh it writes crosses itself (docs/algorithm.md, "No
+// crossing triangles").
 #pragma once
 
 #include <algorithm>

@@ -3,7 +3,8 @@
 // must find exactly the pairs a test of every pair finds, and TriangleCells with separating
 // planes exactly the triangles a new one crosses, on soups of small and large triangles where
 // many cross, on every triangle of nearby points in a random cloud, and where four points lie on
-// one circle.
+// one circle; and, given coordinates finer than float, both judge on those (a crossing the
+// floats hide is refused).
 #include "grow/crossings.hpp"
 
 #include <gtest/gtest.h>
