@@ -227,7 +227,8 @@ Pairs TriangleCells::crossing_pairs(const CrossingPositions& positions) const {
   return sorted_union(found);
 }
 
-void TriangleCells::build(Level& level, std::span<const std::uint32_t> members) {
+void TriangleCells::build(Level& level, std::span<const std::uint32_t> members,
+                          std::span<const Box> boxes) {
   const auto home = [&](std::uint64_t k) {
     return static_cast<std::size_t>((k * 0x9E3779B97F4A7C15ull) >> level.shift);
   };
@@ -237,7 +238,7 @@ void TriangleCells::build(Level& level, std::span<const std::uint32_t> members) 
   constexpr std::size_t kAhead = 16;
   std::vector<std::uint64_t> member_keys(members.size());
   for (std::size_t i = 0; i < members.size(); ++i) {
-    const Box box = box_of(points_, triangles_[members[i]]);
+    const Box& box = boxes[members[i]];
     member_keys[i] = key(level.coord(box.lo.x), level.coord(box.lo.y), level.coord(box.lo.z));
   }
   const auto load_ahead = [&](std::size_t i) {
@@ -297,15 +298,17 @@ void TriangleCells::build(Level& level, std::span<const std::uint32_t> members) 
     const std::uint32_t t = members[i];
     const std::uint32_t at = level.end[level.find(member_keys[i])]++;
     level.filed[at] = t;
-    level.boxes[at] = box_of(points_, triangles_[t]);
+    level.boxes[at] = boxes[t];
   }
 }
 
 TriangleCells::TriangleCells(std::span<const Vec3f> points, std::span<const Triangle> triangles)
     : points_(points), triangles_(triangles), level_(triangles.size(), 0) {
+  // Each box worked out once: its corners are scattered over the points.
+  std::vector<Box> boxes(triangles.size());
   std::vector<float> extents(triangles.size());
   for (std::uint32_t t = 0; t < triangles.size(); ++t) {
-    const Box box = box_of(points, triangles[t]);
+    const Box& box = boxes[t] = box_of(points, triangles[t]);
     extents[t] = std::max({box.hi.x - box.lo.x, box.hi.y - box.lo.y, box.hi.z - box.lo.z});
   }
   // The first level's cell holds nine triangles in ten whole; the rest are few enough to be
@@ -334,7 +337,7 @@ TriangleCells::TriangleCells(std::span<const Vec3f> points, std::span<const Tria
   }
   extents = {};
   for (std::size_t l = 0; l < levels_.size(); ++l) {
-    build(levels_[l], members[l]);
+    build(levels_[l], members[l], boxes);
     members[l] = {};
   }
 }

@@ -198,7 +198,8 @@ class TriangleCells {
     return static_cast<std::uint64_t>(x + kBias) << 42 |
            static_cast<std::uint64_t>(y + kBias) << 21 | static_cast<std::uint64_t>(z + kBias);
   }
-  void build(Level& level, std::span<const std::uint32_t> members);
+  // Files `members` in `level`; boxes[t] is triangle t's box.
+  void build(Level& level, std::span<const std::uint32_t> members, std::span<const Box> boxes);
   // Calls visit(e) for the places e in level.filed of the triangles whose lower corner lies in
   // the cells that [lo - cell, hi] covers: every filed triangle whose box can overlap [lo, hi].
   template <class Visit>
