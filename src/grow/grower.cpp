@@ -1256,6 +1256,7 @@ class Grower {
   // that touches the rest at a corner is a loop of its own).
   bool fill_fits(const Triangle& t) {
     const detail::Box box = detail::box_of(grid_.points(), t);
+    // A sliver (no circumball) first: the crossing tests below never see one.
     Ball ball;
     if (!detail::padded_circumball(grid_.position(t[0]), grid_.position(t[1]), grid_.position(t[2]),
                                    ball)) {
@@ -1278,8 +1279,7 @@ class Grower {
         blocks(loop_near_[last_blocker_])) {
       return false;
     }
-    // The boxes that overlap: about one in five, in no order a branch predictor could learn.
-    const std::uint32_t hits = near_boxes_.overlapping(box, 0, count, near_hits_.data());
+    const std::uint32_t hits = near_boxes_.overlapping(box, near_hits_.data());
     for (std::uint32_t k = 0; k < hits; ++k) {
       const std::uint32_t i = near_hits_[k];
       if (i != last_blocker_ && blocks(loop_near_[i])) {
@@ -1737,23 +1737,23 @@ class Grower {
         hi_x[i] = b.hi.x, hi_y[i] = b.hi.y, hi_z[i] = b.hi.z;
       }
     }
-    // Lists in `hits` the places in [first, end) whose boxes overlap `box` and returns how many:
-    // the tests without a branch (about one box in three overlaps, in no order a branch
-    // predictor could learn), then the list without one.
-    std::uint32_t overlapping(const detail::Box& box, std::uint32_t first, std::uint32_t end,
-                              std::uint32_t* hits) {
+    // Lists in `hits` the places whose boxes overlap `box` and returns how many: the tests
+    // without a branch (about one box in five overlaps, in no order a branch predictor could
+    // learn), then the list without one.
+    std::uint32_t overlapping(const detail::Box& box, std::uint32_t* hits) {
+      const auto end = static_cast<std::uint32_t>(overlaps.size());
       // Local pointers: a store through a byte pointer could alias the vectors' own, which
       // would keep the compiler from running the tests several at a time.
       const float *lx = lo_x.data(), *ly = lo_y.data(), *lz = lo_z.data();
       const float *hx = hi_x.data(), *hy = hi_y.data(), *hz = hi_z.data();
       std::uint8_t* out = overlaps.data();
       const Vec3f lo = box.lo, hi = box.hi;
-      for (std::uint32_t i = first; i < end; ++i) {
+      for (std::uint32_t i = 0; i < end; ++i) {
         out[i] = static_cast<std::uint8_t>((lo.x <= hx[i]) & (lx[i] <= hi.x) & (lo.y <= hy[i]) &
                                            (ly[i] <= hi.y) & (lo.z <= hz[i]) & (lz[i] <= hi.z));
       }
       std::uint32_t count = 0;
-      for (std::uint32_t i = first; i < end; ++i) {
+      for (std::uint32_t i = 0; i < end; ++i) {
         hits[count] = i;
         count += out[i];
       }
