@@ -545,10 +545,8 @@ class Grower {
     loop_near_.clear();
     last_blocker_ = kNoIndex;
     cells.for_each_near(box.lo, box.hi, [&](std::uint32_t other, const detail::Box& near_box) {
-      if (!skip(other)) loop_near_.push_back({other, near_box});
+      if (!skip(other)) loop_near_.push(other, near_box);
     });
-    near_boxes_.assign(loop_near_);
-    near_hits_.resize(loop_near_.size());
   }
 
   // Whether the fan from `loop` (its edges loop[i] -> loop[i+1] as the triangles outside them,
@@ -967,10 +965,10 @@ class Grower {
                                              grid_.position(t[2]));
           nearest2 = std::min(nearest2, norm2(p - q));
         }
-        for (const NearTriangle& near : loop_near_) {
+        for (const std::uint32_t near : loop_near_.index) {
           if (nearest2 <= limit2) break;
-          if (dead[near.index]) continue;
-          const Triangle& t = triangles_[near.index];
+          if (dead[near]) continue;
+          const Triangle& t = triangles_[near];
           const Vec3 q = closest_on_triangle(p, grid_.position(t[0]), grid_.position(t[1]),
                                              grid_.position(t[2]));
           nearest2 = std::min(nearest2, norm2(p - q));
@@ -1265,8 +1263,8 @@ class Grower {
     // Neighbours side by side with the candidate are mostly settled by its planes, built once
     // a near triangle's box overlaps its box.
     std::optional<SeparatingPlanes> planes;
-    const auto blocks = [&](const NearTriangle& near) {
-      const Triangle& o = triangles_[near.index];
+    const auto blocks = [&](std::uint32_t place) {
+      const Triangle& o = triangles_[loop_near_.index[place]];
       if (!planes) planes.emplace(positions_.planes(t));
       if (positions_.separate(*planes, o)) return false;
       if (std::is_permutation(o.begin(), o.end(), t.begin())) return true;
@@ -1274,15 +1272,12 @@ class Grower {
     };
     // The triangle that refused the last candidate is asked first: where the surface folds over
     // a hole, one grown triangle refuses most of the candidates across it.
-    const auto count = static_cast<std::uint32_t>(loop_near_.size());
-    if (last_blocker_ < count && detail::overlap(box, loop_near_[last_blocker_].box) &&
-        blocks(loop_near_[last_blocker_])) {
+    if (last_blocker_ < loop_near_.size() && loop_near_.overlaps(last_blocker_, box) &&
+        blocks(last_blocker_)) {
       return false;
     }
-    const std::uint32_t hits = near_boxes_.overlapping(box, near_hits_.data());
-    for (std::uint32_t k = 0; k < hits; ++k) {
-      const std::uint32_t i = near_hits_[k];
-      if (i != last_blocker_ && blocks(loop_near_[i])) {
+    for (const std::uint32_t i : loop_near_.overlapping(box)) {
+      if (i != last_blocker_ && blocks(i)) {
         last_blocker_ = i;
         return false;
       }
@@ -1309,19 +1304,16 @@ class Grower {
     const detail::Box box = detail::box_of(grid_.points(), t);
     const SeparatingPlanes planes = positions_.planes(t);
     const std::size_t before = folded_over_.size();
-    for (const NearTriangle& near : loop_near_) {
-      const Triangle& other = triangles_[near.index];
-      if (!detail::overlap(box, near.box) || positions_.separate(planes, other) ||
-          !positions_.cross(t, other)) {
-        continue;
-      }
+    for (const std::uint32_t place : loop_near_.overlapping(box)) {
+      const Triangle& other = triangles_[loop_near_.index[place]];
+      if (positions_.separate(planes, other) || !positions_.cross(t, other)) continue;
       if (std::none_of(other.begin(), other.end(), [&](Index v) {
             return std::find(loop_.begin(), loop_.end(), v) != loop_.end();
           })) {
         off_the_fans_ = true;
         return true;
       }
-      folded_over_.push_back(near.index);
+      folded_over_.push_back(loop_near_.index[place]);
     }
     return folded_over_.size() > before;
   }
@@ -1718,53 +1710,58 @@ class Grower {
   std::vector<WalkPoint> cand_;
   std::vector<Index> excluded_;  // points a retried edge has already failed with
   std::vector<std::pair<double, std::uint32_t>> near_;
-  // fill_holes: the grown triangles near the loop being filled, with their boxes
-  struct NearTriangle {
-    std::uint32_t index;
-    detail::Box box;
-  };
-  std::vector<NearTriangle> loop_near_;
-  // Their boxes, a coordinate per array, so that the overlap tests run four or eight at a time.
-  struct NearBoxes {
+  // fill_holes: the grown triangles near the loop being filled, and their boxes a coordinate per
+  // array, so that the overlap tests run four or more at a time.
+  struct NearTriangles {
+    std::vector<std::uint32_t> index;
     std::vector<float> lo_x, lo_y, lo_z, hi_x, hi_y, hi_z;
-    std::vector<std::uint8_t> overlaps;
-    void assign(std::span<const NearTriangle> near) {
-      for (auto* v : {&lo_x, &lo_y, &lo_z, &hi_x, &hi_y, &hi_z}) v->resize(near.size());
-      overlaps.resize(near.size());
-      for (std::size_t i = 0; i < near.size(); ++i) {
-        const detail::Box& b = near[i].box;
-        lo_x[i] = b.lo.x, lo_y[i] = b.lo.y, lo_z[i] = b.lo.z;
-        hi_x[i] = b.hi.x, hi_y[i] = b.hi.y, hi_z[i] = b.hi.z;
-      }
+    std::vector<std::uint8_t> overlap;  // overlapping's scratch
+    std::vector<std::uint32_t> hits;    // and its answer
+
+    void clear() {
+      index.clear();
+      for (auto* v : {&lo_x, &lo_y, &lo_z, &hi_x, &hi_y, &hi_z}) v->clear();
     }
-    // Lists in `hits` the places whose boxes overlap `box` and returns how many: the tests
-    // without a branch (about one box in five overlaps, in no order a branch predictor could
-    // learn), then the list without one.
-    std::uint32_t overlapping(const detail::Box& box, std::uint32_t* hits) {
-      const auto end = static_cast<std::uint32_t>(overlaps.size());
+    void push(std::uint32_t t, const detail::Box& b) {
+      index.push_back(t);
+      lo_x.push_back(b.lo.x), lo_y.push_back(b.lo.y), lo_z.push_back(b.lo.z);
+      hi_x.push_back(b.hi.x), hi_y.push_back(b.hi.y), hi_z.push_back(b.hi.z);
+    }
+    std::size_t size() const { return index.size(); }
+    // Whether the box at place p overlaps `box`.
+    bool overlaps(std::size_t p, const detail::Box& box) const {
+      return box.lo.x <= hi_x[p] && lo_x[p] <= box.hi.x && box.lo.y <= hi_y[p] &&
+             lo_y[p] <= box.hi.y && box.lo.z <= hi_z[p] && lo_z[p] <= box.hi.z;
+    }
+    // The places whose boxes overlap `box`, in order: the tests without a branch (about one box
+    // in five overlaps, in no order a branch predictor could learn), then the list without one.
+    std::span<const std::uint32_t> overlapping(const detail::Box& box) {
+      const std::size_t end = size();
+      overlap.resize(end);
+      hits.resize(end);
       // Local pointers: a store through a byte pointer could alias the vectors' own, which
       // would keep the compiler from running the tests several at a time.
       const float *lx = lo_x.data(), *ly = lo_y.data(), *lz = lo_z.data();
       const float *hx = hi_x.data(), *hy = hi_y.data(), *hz = hi_z.data();
-      std::uint8_t* out = overlaps.data();
+      std::uint8_t* out = overlap.data();
+      std::uint32_t* listed = hits.data();
       const Vec3f lo = box.lo, hi = box.hi;
-      for (std::uint32_t i = 0; i < end; ++i) {
+      for (std::size_t i = 0; i < end; ++i) {
         out[i] = static_cast<std::uint8_t>((lo.x <= hx[i]) & (lx[i] <= hi.x) & (lo.y <= hy[i]) &
                                            (ly[i] <= hi.y) & (lo.z <= hz[i]) & (lz[i] <= hi.z));
       }
-      std::uint32_t count = 0;
-      for (std::uint32_t i = 0; i < end; ++i) {
-        hits[count] = i;
+      std::size_t count = 0;
+      for (std::size_t i = 0; i < end; ++i) {
+        listed[count] = static_cast<std::uint32_t>(i);
         count += out[i];
       }
-      return count;
+      return {listed, count};
     }
   };
-  NearBoxes near_boxes_;
+  NearTriangles loop_near_;
   std::vector<std::uint32_t> folded_over_;  // survey_crossings: what crosses a hole's first filling
   bool off_the_fans_ = false;               // and whether one of them is of no loop point's fan
   std::uint32_t last_blocker_ = kNoIndex;   // fill_fits: the place in loop_near_ that refused last
-  std::vector<std::uint32_t> near_hits_;    // fill_fits: places in loop_near_ whose boxes overlap
   // An edge of a widened hole's border, as the triangle outside it faces (outside, once found).
   struct Border {
     Index from, to;
