@@ -332,6 +332,7 @@ void write_and_report(const TileSource& source,
         .fixed("seconds", seconds, 3)
         .fixed("seconds_grid", r.seconds_grid, 3)
         .fixed("seconds_grow", r.seconds_grow, 3)
+        .fixed("seconds_finish", r.seconds_finish, 3)
         .fixed("seconds_stitch", summary.seconds_stitch, 3)
         .fixed("seconds_cleanup", r.seconds_cleanup, 3)
         .fixed("ktriangles_per_second", ktps, 1)

@@ -71,6 +71,10 @@ struct MeshReport {
   double spacing = 0.0;                  // estimated median nearest-neighbour distance
   double seconds_grid = 0.0;
   double seconds_grow = 0.0;
+  // Of seconds_grow: the finishing of the surface once growth is over (hole filling, the fan
+  // clean-up between its rounds, scraps and caps; docs/algorithm.md, "Hole filling"), which
+  // --max-hole-edges 0 skips.
+  double seconds_finish = 0.0;
   double seconds_cleanup = 0.0;
 };
 

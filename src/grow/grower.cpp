@@ -11,6 +11,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -111,7 +112,7 @@ class Grower {
       drain();
     }
     if (options_.close_gaps) close_three_edge_gaps();
-    finish_surface();
+    result.seconds_finish = finish_surface();
     // Groups in the layout of the context: every preloaded triangle (those a filling replaced
     // too), then the new ones.
     const std::size_t loaded = context.preload.size(), added = triangles_.size() - preloaded_;
@@ -317,10 +318,11 @@ class Grower {
   // run on alpe): the non-manifold pass keeps one fan, and the second round widens what that
   // leaves. Then scraps of surface near the rest go (remove_scraps), and last a piece whose only
   // border is a short loop is closed with a point left over, where that makes a closed surface
-  // (cap_single_loops).
-  void finish_surface() {
+  // (cap_single_loops). Returns the wall seconds it took (0 when holes are not filled).
+  double finish_surface() {
     guard_.reset();  // growth is over
-    if (options_.max_hole_edges < 3) return;
+    if (options_.max_hole_edges < 3) return 0;
+    const auto start = std::chrono::steady_clock::now();
     fill_small_holes(/*widen_fan_gaps=*/false);
     // Points whose whole star is in this run: growable, and no corner of a triangle kept from
     // before (the clean-up of the tiled pipeline judges those).
@@ -343,6 +345,7 @@ class Grower {
     }
     if (options_.max_hole_rings > 0) remove_scraps();
     cap_single_loops();
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
 
   // Removes the pieces of surface that have no interior point (a lone triangle, a strip: every

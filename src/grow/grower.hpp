@@ -59,6 +59,7 @@ struct GrowResult {
   // (docs/algorithm.md, "Hole filling").
   std::vector<std::uint32_t> removed_preload;
   std::uint64_t seeds = 0;
+  double seconds_finish = 0;  // wall seconds of the surface finishing (MeshReport::seconds_finish)
   // Points where a triangle started a second fan (fronts meeting at a point): the only places a
   // non-manifold vertex can be, in the order they arose.
   std::vector<Index> second_fans;

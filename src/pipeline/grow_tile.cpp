@@ -140,6 +140,7 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
   GrowResult grown = grow_mesh(grid, mesh_options, context);
   fillable = std::vector<std::uint8_t>();
   out.report.seeds = grown.seeds;
+  out.report.seconds_finish = grown.seconds_finish;
 
   // Per grid point: its index among the tile's points (which come first), or kNoIndex for a
   // halo point.

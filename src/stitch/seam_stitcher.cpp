@@ -649,6 +649,7 @@ void Stitcher::add(std::size_t tile, PreparedTile prepared) {
   r.duplicates_merged += growth.report.duplicates_merged;
   r.seconds_grid += growth.report.seconds_grid;
   r.seconds_grow += growth.report.seconds_grow;
+  r.seconds_finish += growth.report.seconds_finish;
   r.triangles_grown += growth.triangles.size() + growth.report.triangles_removed;
   r.triangles_removed += growth.report.triangles_removed;
   r.non_manifold_vertices_fixed += growth.report.non_manifold_vertices_fixed;
