@@ -21,6 +21,7 @@
 
 #include "cleanup/cleanup.hpp"
 #include "common/edge_map.hpp"
+#include "common/seconds_since.hpp"
 #include "common/separating_planes.hpp"
 #include "common/union_find.hpp"
 #include "grow/bucket_queue.hpp"
@@ -345,7 +346,7 @@ class Grower {
     }
     if (options_.max_hole_rings > 0) remove_scraps();
     cap_single_loops();
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return seconds_since(start);
   }
 
   // Removes the pieces of surface that have no interior point (a lone triangle, a strip: every

@@ -19,6 +19,7 @@
 
 #include "cleanup/cleanup.hpp"
 #include "common/local_frame.hpp"
+#include "common/seconds_since.hpp"
 #include "g2s/tile_stages.hpp"
 #include "grid/hash_grid.hpp"
 #include "grow/crossings.hpp"
@@ -120,8 +121,7 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
       detail::output_positions(grid, points.xyz, frame.exact(points.xyz));
   out.report.points = own;
   out.report.spacing = grid.spacing();
-  out.report.seconds_grid =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  out.report.seconds_grid = seconds_since(start);
   const auto grow_start = std::chrono::steady_clock::now();
   MeshOptions mesh_options = options.mesh;
   mesh_options.progress = {};  // tiles grow in parallel; the pipeline reports per tile
@@ -192,8 +192,7 @@ TileGrowth grow_tile(const TileSource& source, std::size_t tile, const PipelineO
   }
   clean_deep_fans(out, point_depth, seam_depth(tiles, tile, options), halo_corners);
   put_final_first(out, point_depth, seam_depth(tiles, tile, options, true));
-  out.report.seconds_grow =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - grow_start).count();
+  out.report.seconds_grow = seconds_since(grow_start);
   return out;
 }
 

@@ -30,6 +30,7 @@
 
 #include "common/id_map.hpp"
 #include "common/local_frame.hpp"
+#include "common/seconds_since.hpp"
 #include "common/triangle_intersection.hpp"
 #include "g2s/error.hpp"
 #include "g2s/tile_stages.hpp"
@@ -42,10 +43,6 @@
 
 namespace g2s {
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 class SeamStitcher {
  public:
